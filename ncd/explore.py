@@ -1,0 +1,85 @@
+"""Exploring the solutions of one step: ensembles of NLGS runs (Moreau 2005, section 2).
+
+Each member of an ensemble is one NLGS run on the same core problem, started
+from an initial guess (zero, warm, or drawn at random from a stated range) with
+a review order (fixed, or a random permutation).  Its randomness comes only
+from ``numpy.random.default_rng((member, root_seed))``, so a member gives the
+same result whatever shard or process runs it.
+"""
+import time
+
+import numpy as np
+
+from .nlgs import SolverSettings
+from .stepper import initial_guess, solve_problem
+
+INIT_MODES = ("zero", "warm", "random")
+
+
+def member_rng(member, root_seed):
+    """The generator of one ensemble member."""
+    return np.random.default_rng((int(member), int(root_seed)))
+
+
+def random_guess(rng, mu, scale):
+    """Impulses drawn uniformly in the Coulomb cone truncated at ``s_n <= scale``:
+    ``s_n ~ U[0, scale]``, ``s_t ~ U[-mu s_n, mu s_n]`` (per contact ``mu``)."""
+    sn = rng.uniform(0.0, 1.0, size=len(mu)) * scale
+    st = rng.uniform(-1.0, 1.0, size=len(mu)) * mu * sn
+    return np.column_stack([sn, st])
+
+
+def shard_members(n_members, shard, n_shards):
+    """Members of shard ``shard`` (0-based) among ``n_shards``: a contiguous block."""
+    if not (0 <= shard < n_shards):
+        raise ValueError(f"shard {shard} is outside 0..{n_shards - 1}")
+    bounds = np.linspace(0, n_members, n_shards + 1).round().astype(int)
+    return np.arange(bounds[shard], bounds[shard + 1])
+
+
+def explore(scene, problem, members, root_seed, init="zero", review="random", guess_scale=None,
+            settings=SolverSettings(), progress=None):
+    """Run one NLGS per member on ``problem``; returns a dict of arrays stacked over members.
+
+    ``init``: "zero", "warm" (the scene's previous impulses) or "random"
+    (:func:`random_guess` with ``guess_scale``); ``review``: "fixed" or "random".
+    ``progress(done, total)`` is called now and then.
+    """
+    if init not in INIT_MODES:
+        raise ValueError(f"init = {init!r} must be one of {INIT_MODES}")
+    if review not in ("fixed", "random"):
+        raise ValueError(f"review = {review!r} must be 'fixed' or 'random'")
+    if init == "random" and not (guess_scale and guess_scale > 0):
+        raise ValueError(f"init = 'random' needs guess_scale > 0, got {guess_scale!r}")
+    members = np.asarray(members, dtype=np.int64)
+    n = problem.contacts.n
+    nm = scene.n_mobile
+    out = {
+        "impulse": np.zeros((len(members), n, 2)),
+        "vel": np.zeros((len(members), nm, 2)),
+        "spin": np.zeros((len(members), nm)),
+        "sweeps": np.zeros(len(members), np.int64),
+        "residual": np.zeros(len(members)),
+        "change": np.zeros(len(members)),
+        "converged": np.zeros(len(members), bool),
+        "wall_time": np.zeros(len(members)),
+    }
+    warm = initial_guess(scene, problem, "warm") if init == "warm" else None
+    for k, member in enumerate(members):
+        rng = member_rng(member, root_seed)
+        order = rng.permutation(n) if review == "random" else None
+        guess = warm if init == "warm" else (
+            random_guess(rng, problem.contacts.mu, guess_scale) if init == "random" else None)
+        t0 = time.perf_counter()
+        result, vel, spin = solve_problem(scene, problem, guess, order, settings)
+        out["wall_time"][k] = time.perf_counter() - t0
+        out["impulse"][k] = result.impulse
+        out["vel"][k] = vel[:nm]
+        out["spin"][k] = spin[:nm]
+        out["sweeps"][k] = result.sweeps
+        out["residual"][k] = result.residual
+        out["change"][k] = result.change
+        out["converged"][k] = result.converged
+        if progress is not None:
+            progress(k + 1, len(members))
+    return out

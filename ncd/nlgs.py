@@ -1,0 +1,250 @@
+"""Nonlinear Gauss-Seidel (NLGS) for the core problem of a Contact Dynamics step.
+
+Contacts are reviewed one at a time in a given ``review_order``; each is
+solved exactly (:func:`ncd.local_solver.solve_single_contact`) with the other
+impulses frozen, and the result is propagated at once (Moreau 2005, section 2).
+Two forms of the same problem share the iteration driver:
+
+* disc form: body velocities ``u`` are updated incrementally,
+  ``u += M^-1 H_alpha (s_new - s_old)``, so a sweep costs O(contacts);
+* local form: ``U = W s + q`` with a Delassus matrix ``W`` given dense or
+  sparse, as NSCD codes (LMGC90, Siconos) export 2-D frictional problems.
+
+Each run reports its sweeps, the relative impulse change of the last sweep,
+the relative natural-map residual (:func:`ncd.local_solver.natural_map_sq`,
+``rho_alpha = 1 / W_alpha,nn``, divided by the largest of ``|s|`` and
+``|rho q_free|``) and a converged flag.  The stopping criterion is either the
+residual (default) or the change; non-convergence at ``max_sweeps`` is flagged.
+"""
+from dataclasses import dataclass, asdict
+
+import numpy as np
+import scipy.sparse as sp
+from numba import njit
+
+from .contacts import apply_impulses, apply_one, delassus_blocks, local_velocity
+from .local_solver import natural_map_sq, solve_single_contact
+
+CRITERIA = {"residual": 0, "change": 1}
+
+
+@dataclass(frozen=True)
+class SolverSettings:
+    """NLGS settings: tolerance on the chosen criterion, sweep budget."""
+    tol: float = 1e-8
+    max_sweeps: int = 20000
+    criterion: str = "residual"   # "residual" (natural map) or "change"
+    check_every: int = 1          # sweeps between residual evaluations
+
+    def __post_init__(self):
+        if not (np.isfinite(self.tol) and self.tol > 0):
+            raise ValueError(f"tol = {self.tol!r} must be > 0")
+        if self.max_sweeps < 1 or self.check_every < 1:
+            raise ValueError(f"max_sweeps = {self.max_sweeps}, check_every = {self.check_every} must be >= 1")
+        if self.criterion not in CRITERIA:
+            raise ValueError(f"criterion = {self.criterion!r} must be one of {sorted(CRITERIA)}")
+
+    def as_attrs(self):
+        return {f"solver_{k}": v for k, v in asdict(self).items()}
+
+
+@dataclass
+class NLGSResult:
+    """Impulses ``(n, 2)`` (normal, tangential), final status per contact and diagnostics."""
+    impulse: np.ndarray
+    status: np.ndarray
+    sweeps: int
+    residual: float
+    change: float
+    converged: bool
+
+    @property
+    def impulse_n(self):
+        return self.impulse[:, 0]
+
+    @property
+    def impulse_t(self):
+        return self.impulse[:, 1]
+
+
+@njit(cache=True)
+def _iterate(sweep, residual, data, order, status, scale, tol, max_sweeps, criterion, check_every):
+    """The NLGS driver: sweeps until the criterion holds or ``max_sweeps``."""
+    tiny = 1e-300
+    change = np.inf
+    res = np.inf
+    for k in range(1, max_sweeps + 1):
+        dsum, ssum = sweep(data, order, status)
+        change = dsum / max(ssum, tiny) if ssum > 0.0 else 0.0
+        if k % check_every == 0 or k == max_sweeps or (criterion == 1 and change <= tol):
+            rsq, ssq = residual(data)
+            res = np.sqrt(rsq) / max(scale, np.sqrt(ssq), tiny)
+            if (criterion == 0 and res <= tol) or (criterion == 1 and change <= tol):
+                return k, res, change, True
+    return max_sweeps, res, change, False
+
+
+# ---------------------------------------------------------------- disc form
+@njit(cache=True)
+def _sweep_discs(data, order, status):
+    body_a, body_b, normal, arm_a, arm_b, W, mu, bias, inv_mass, inv_inertia, vel, spin, imp = data
+    dsum = 0.0
+    ssum = 0.0
+    for k in range(order.shape[0]):
+        c = order[k]
+        a = body_a[c]
+        b = body_b[c]
+        nx = normal[c, 0]
+        ny = normal[c, 1]
+        vx = vel[a, 0]
+        vy = vel[a, 1]
+        wt = arm_a[c] * spin[a]
+        if b >= 0:
+            vx -= vel[b, 0]
+            vy -= vel[b, 1]
+            wt += arm_b[c] * spin[b]
+        sn = imp[c, 0]
+        st = imp[c, 1]
+        qn = vx * nx + vy * ny - W[c, 0, 0] * sn - W[c, 0, 1] * st + bias[c, 0]
+        qt = -vx * ny + vy * nx - wt - W[c, 1, 0] * sn - W[c, 1, 1] * st + bias[c, 1]
+        rn, rt, st_ = solve_single_contact(W[c, 0, 0], W[c, 0, 1], W[c, 1, 0], W[c, 1, 1], qn, qt, mu[c])
+        status[c] = st_
+        dn = rn - sn
+        dt = rt - st
+        imp[c, 0] = rn
+        imp[c, 1] = rt
+        apply_one(a, b, nx, ny, arm_a[c], arm_b[c], inv_mass, inv_inertia, dn, dt, vel, spin)
+        dsum += abs(dn) + abs(dt)
+        ssum += abs(rn) + abs(rt)
+    return dsum, ssum
+
+
+@njit(cache=True)
+def _residual_discs(data):
+    body_a, body_b, normal, arm_a, arm_b, W, mu, bias, inv_mass, inv_inertia, vel, spin, imp = data
+    U = local_velocity(body_a, body_b, normal, arm_a, arm_b, vel, spin, np.empty((body_a.shape[0], 2)))
+    rsq = 0.0
+    ssq = 0.0
+    for c in range(body_a.shape[0]):
+        rsq += natural_map_sq(imp[c, 0], imp[c, 1], U[c, 0] + bias[c, 0], U[c, 1] + bias[c, 1],
+                              mu[c], 1.0 / W[c, 0, 0])
+        ssq += imp[c, 0] ** 2 + imp[c, 1] ** 2
+    return rsq, ssq
+
+
+def _scale(q, W):
+    """``|rho q|`` with ``rho_alpha = 1 / W_alpha,nn``: the impulse scale of the problem."""
+    return float(np.sqrt(np.sum((q / W[:, 0, 0][:, None]) ** 2)))
+
+
+def restitution_bias(contacts, U_initial):
+    """``e * U_i`` per component, for approaching contacts only (``U_i,n < 0``).
+
+    The law is imposed on Moreau's weighted mean ``(U_f + e U_i) / (1 + e)``;
+    since the Coulomb law is invariant under positive scaling of each velocity
+    component, this is the law on ``U_f + e U_i``.
+    """
+    approaching = U_initial[:, 0] < 0.0
+    return np.where(approaching[:, None],
+                    np.column_stack([contacts.e_n, contacts.e_t]) * U_initial, 0.0)
+
+
+def solve_discs(scene, contacts, vel, spin, guess=None, review_order=None,
+                settings=SolverSettings(), bias=None, W=None):
+    """Solve the core problem of one step by NLGS in disc form.
+
+    ``vel, spin`` hold the free velocities on entry and the end-of-step
+    velocities ``u_f`` on return (modified in place).  ``guess`` is the initial
+    impulse array (n, 2) (zero if None); ``review_order`` a permutation of the
+    contacts (identity if None); ``bias`` the restitution term ``e U_i``.
+    """
+    n = contacts.n
+    impulse = np.zeros((n, 2)) if guess is None else np.array(guess, dtype=float).reshape(n, 2)
+    status = np.zeros(n, np.int8)
+    if n == 0:
+        return NLGSResult(impulse, status, 0, 0.0, 0.0, True)
+    order = np.arange(n) if review_order is None else np.asarray(review_order, dtype=np.int64)
+    bias = np.zeros((n, 2)) if bias is None else bias
+    c = contacts
+    W = delassus_blocks(c.body_a, c.body_b, c.arm_a, c.arm_b, scene.inv_mass, scene.inv_inertia) if W is None else W
+    q_free = local_velocity(c.body_a, c.body_b, c.normal, c.arm_a, c.arm_b, vel, spin, np.empty((n, 2))) + bias
+    apply_impulses(c.body_a, c.body_b, c.normal, c.arm_a, c.arm_b, scene.inv_mass, scene.inv_inertia,
+                   impulse, vel, spin)
+    data = (c.body_a, c.body_b, c.normal, c.arm_a, c.arm_b, W, c.mu, bias,
+            scene.inv_mass, scene.inv_inertia, vel, spin, impulse)
+    sweeps, res, change, ok = _iterate(_sweep_discs, _residual_discs, data, order, status,
+                                       _scale(q_free, W), settings.tol, settings.max_sweeps,
+                                       CRITERIA[settings.criterion], settings.check_every)
+    return NLGSResult(impulse, status, int(sweeps), float(res), float(change), bool(ok))
+
+
+# ---------------------------------------------------------------- local form
+@njit(cache=True)
+def _local_U(indptr, indices, values, q, flat, row):
+    u = q[row]
+    for j in range(indptr[row], indptr[row + 1]):
+        u += values[j] * flat[indices[j]]
+    return u
+
+
+@njit(cache=True)
+def _sweep_local(data, order, status):
+    indptr, indices, values, q, Wd, mu, flat = data
+    dsum = 0.0
+    ssum = 0.0
+    for k in range(order.shape[0]):
+        c = order[k]
+        sn = flat[2 * c]
+        st = flat[2 * c + 1]
+        qn = _local_U(indptr, indices, values, q, flat, 2 * c) - Wd[c, 0, 0] * sn - Wd[c, 0, 1] * st
+        qt = _local_U(indptr, indices, values, q, flat, 2 * c + 1) - Wd[c, 1, 0] * sn - Wd[c, 1, 1] * st
+        rn, rt, st_ = solve_single_contact(Wd[c, 0, 0], Wd[c, 0, 1], Wd[c, 1, 0], Wd[c, 1, 1], qn, qt, mu[c])
+        status[c] = st_
+        flat[2 * c] = rn
+        flat[2 * c + 1] = rt
+        dsum += abs(rn - sn) + abs(rt - st)
+        ssum += abs(rn) + abs(rt)
+    return dsum, ssum
+
+
+@njit(cache=True)
+def _residual_local(data):
+    indptr, indices, values, q, Wd, mu, flat = data
+    rsq = 0.0
+    ssq = 0.0
+    for c in range(Wd.shape[0]):
+        un = _local_U(indptr, indices, values, q, flat, 2 * c)
+        ut = _local_U(indptr, indices, values, q, flat, 2 * c + 1)
+        rsq += natural_map_sq(flat[2 * c], flat[2 * c + 1], un, ut, mu[c], 1.0 / Wd[c, 0, 0])
+        ssq += flat[2 * c] ** 2 + flat[2 * c + 1] ** 2
+    return rsq, ssq
+
+
+def solve_local(W, q, mu, guess=None, review_order=None, settings=SolverSettings()):
+    """NLGS on a 2-D frictional contact problem in local form.
+
+    Find ``s`` (n, 2) with ``U = W s + q`` and the Coulomb law at each contact.
+    ``W`` is (2n, 2n), dense or scipy.sparse, rows ordered (n_1, t_1, n_2, ...);
+    ``q`` (2n,); ``mu`` scalar or (n,).
+    """
+    Wc = sp.csr_matrix(W, dtype=float)
+    q = np.asarray(q, dtype=float).ravel()
+    n = len(q) // 2
+    if Wc.shape != (2 * n, 2 * n) or len(q) != 2 * n:
+        raise ValueError(f"W has shape {Wc.shape}, q has length {len(q)}: expected (2n, 2n) and 2n")
+    mu = np.broadcast_to(np.asarray(mu, dtype=float), (n,)).copy()
+    if np.any(mu < 0):
+        raise ValueError(f"mu must be >= 0; got min {mu.min()}")
+    Wd = np.empty((n, 2, 2))
+    for i, j in ((0, 0), (0, 1), (1, 0), (1, 1)):
+        Wd[:, i, j] = Wc[np.arange(n) * 2 + i, np.arange(n) * 2 + j].A1
+    if np.any(Wd[:, 0, 0] <= 0) or np.any(Wd[:, 0, 0] * Wd[:, 1, 1] - Wd[:, 0, 1] * Wd[:, 1, 0] <= 0):
+        raise ValueError("the diagonal 2x2 blocks of W must be positive definite")
+    flat = np.zeros(2 * n) if guess is None else np.array(guess, dtype=float).ravel().copy()
+    order = np.arange(n) if review_order is None else np.asarray(review_order, dtype=np.int64)
+    status = np.zeros(n, np.int8)
+    data = (Wc.indptr.astype(np.int64), Wc.indices.astype(np.int64), Wc.data, q, Wd, mu, flat)
+    sweeps, res, change, ok = _iterate(_sweep_local, _residual_local, data, order, status,
+                                       _scale(q.reshape(n, 2), Wd), settings.tol, settings.max_sweeps,
+                                       CRITERIA[settings.criterion], settings.check_every)
+    return NLGSResult(flat.reshape(n, 2), status, int(sweeps), float(res), float(change), bool(ok))

@@ -1,0 +1,166 @@
+"""Moreau-Jean time stepping (Moreau 2005, section 2) and the equilibrium test.
+
+One step from ``t_i`` to ``t_f = t_i + h`` with the theta-method:
+
+1. middle configuration ``q_m = q_i + (1 - theta) h u_i``;
+2. active set (Moreau's rule): the contacts whose gap at ``q_m`` is
+   ``<= gap_tolerance`` (a tiny positive slack, default ``1e-9`` of the
+   smallest radius, so that exactly touching discs are in contact);
+3. impulsional dynamics ``M (u_f - u_i) = h F + sum_alpha H_alpha s_alpha``
+   with the contact law imposed on ``U_alpha(u_f)``, or with restitution on
+   Moreau's weighted mean ``(U_f + e U_i) / (1 + e)`` per component for
+   approaching contacts; solved by NLGS (:mod:`ncd.nlgs`);
+4. ``q_f = q_m + theta h u_f``.
+
+The report of each step carries the largest interpenetration (``-min gap`` at
+``q_m``), the NLGS sweeps, change, residual and converged flag.  A state that
+goes non-finite or faster than ``speed_limit`` raises :class:`SimulationError`.
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+from .contacts import delassus_blocks, detect_contacts, local_velocity, match_warm
+from .model import InputError, SimulationError
+from .nlgs import SolverSettings, restitution_bias, solve_discs
+
+
+@dataclass
+class StepProblem:
+    """The core problem of one step: contacts, Delassus blocks, free velocities."""
+    h: float
+    theta: float
+    contacts: object
+    W: np.ndarray
+    free_vel: np.ndarray
+    free_spin: np.ndarray
+    bias: np.ndarray
+    pos_mid: np.ndarray
+    angle_mid: np.ndarray
+    vel_initial: np.ndarray
+    spin_initial: np.ndarray
+
+    @property
+    def max_penetration(self):
+        return float(max(0.0, -self.contacts.gap.min())) if self.contacts.n else 0.0
+
+
+@dataclass
+class StepReport:
+    time: float
+    n_contacts: int
+    sweeps: int
+    residual: float
+    change: float
+    converged: bool
+    max_penetration: float
+
+
+def _check_h_theta(h, theta):
+    if not (np.isfinite(h) and h > 0):
+        raise InputError(f"time step h = {h!r} must be > 0")
+    if not (0.0 < theta <= 1.0):
+        raise InputError(f"theta = {theta!r} must be in (0, 1]")
+
+
+def prepare_step(scene, h, theta=0.5, gap_tolerance=None, vel=None, spin=None):
+    """Build the core problem of the step from the current state (or ``vel, spin``)."""
+    _check_h_theta(h, theta)
+    vel = scene.vel if vel is None else vel
+    spin = scene.spin if spin is None else spin
+    nm = scene.n_mobile
+    gap_tol = 1e-9 * scene.radius.min() if gap_tolerance is None else gap_tolerance
+    pos_mid = scene.pos.copy()
+    pos_mid[:nm] += (1.0 - theta) * h * vel[:nm]
+    angle_mid = scene.angle + (1.0 - theta) * h * spin
+    contacts = detect_contacts(scene, alert=gap_tol, pos=pos_mid)
+    W = delassus_blocks(contacts.body_a, contacts.body_b, contacts.arm_a, contacts.arm_b,
+                        scene.inv_mass, scene.inv_inertia)
+    c = contacts
+    U_i = local_velocity(c.body_a, c.body_b, c.normal, c.arm_a, c.arm_b, vel, spin, np.empty((c.n, 2)))
+    free_vel = vel.copy()
+    free_vel[:nm] += h * scene.gravity
+    return StepProblem(h, theta, contacts, W, free_vel, spin.copy(), restitution_bias(c, U_i),
+                       pos_mid, angle_mid, vel.copy(), spin.copy())
+
+
+def solve_problem(scene, problem, guess=None, review_order=None, settings=SolverSettings()):
+    """Solve a prepared step; returns ``(result, vel_f, spin_f)`` without touching the scene."""
+    vel = problem.free_vel.copy()
+    spin = problem.free_spin.copy()
+    result = solve_discs(scene, problem.contacts, vel, spin, guess, review_order, settings,
+                         bias=problem.bias, W=problem.W)
+    return result, vel, spin
+
+
+def initial_guess(scene, problem, init):
+    """``init``: "zero", "warm" (previous impulses matched by body pair) or an array."""
+    if isinstance(init, str):
+        if init == "zero":
+            return None
+        if init == "warm":
+            return match_warm(problem.contacts, scene.prev_keys, scene.prev_impulse)
+        raise InputError(f"init = {init!r} must be 'zero', 'warm' or an impulse array")
+    return np.asarray(init, dtype=float).reshape(problem.contacts.n, 2)
+
+
+def step(scene, h, theta=0.5, settings=SolverSettings(), init="warm", review_order=None,
+         gap_tolerance=None, speed_limit=np.inf):
+    """Advance ``scene`` by one Moreau-Jean step in place; returns a :class:`StepReport`."""
+    problem = prepare_step(scene, h, theta, gap_tolerance)
+    guess = initial_guess(scene, problem, init)
+    result, vel, spin = solve_problem(scene, problem, guess, review_order, settings)
+    nm = scene.n_mobile
+    pos = problem.pos_mid.copy()
+    pos[:nm] += theta * h * vel[:nm]
+    angle = problem.angle_mid + theta * h * spin
+    speed = np.abs(vel[:nm]).max()
+    if not (np.all(np.isfinite(pos)) and np.all(np.isfinite(vel)) and np.all(np.isfinite(spin))):
+        raise SimulationError(f"state became non-finite at t = {scene.time + h:.6g} "
+                              f"(NLGS residual {result.residual:.3g}, sweeps {result.sweeps})")
+    if speed > speed_limit:
+        raise SimulationError(f"speed {speed:.3g} exceeds speed_limit = {speed_limit:.3g} "
+                              f"at t = {scene.time + h:.6g}: the simulation diverged")
+    if scene.period > 0:
+        pos[:nm, 0] %= scene.period
+    scene.pos, scene.angle, scene.vel, scene.spin = pos, angle, vel, spin
+    scene.time += h
+    scene.prev_keys = problem.contacts.key
+    scene.prev_impulse = result.impulse
+    return StepReport(scene.time, problem.contacts.n, result.sweeps, result.residual,
+                      result.change, result.converged, problem.max_penetration)
+
+
+@dataclass
+class EquilibriumResult:
+    """Outcome of the one-step equilibrium test (section 2, last paragraph)."""
+    at_rest: bool
+    max_velocity: float      # max |u_f| over translation and r * spin, relative to |g| h
+    forces: np.ndarray       # (n, 2) contact forces r = s / h
+    contacts: object
+    result: object
+
+
+def equilibrium_test(scene, h, settings=SolverSettings(), init="zero", review_order=None,
+                     velocity_tol=1e-6, gap_tolerance=None):
+    """One step from zero velocity: is ``u_f = 0`` (within ``velocity_tol * |g| h``)?
+
+    The scene is not modified.  The contact forces are ``r = s / h``.
+    """
+    zero_v = np.zeros_like(scene.vel)
+    zero_w = np.zeros_like(scene.spin)
+    problem = prepare_step(scene, h, 1.0, gap_tolerance, vel=zero_v, spin=zero_w)
+    guess = initial_guess(scene, problem, init)
+    result, vel, spin = solve_problem(scene, problem, guess, review_order, settings)
+    nm = scene.n_mobile
+    g = np.linalg.norm(scene.gravity)
+    umax = max(np.abs(vel[:nm]).max(), np.abs(spin[:nm] * scene.radius[:nm]).max())
+    rel = float(umax / (g * h)) if g > 0 else float(umax)
+    return EquilibriumResult(rel <= velocity_tol, rel, result.impulse / h, problem.contacts, result)
+
+
+def kinetic_energy(scene):
+    nm = scene.n_mobile
+    m = scene.mass[:nm]
+    inertia = 0.5 * m * scene.radius[:nm] ** 2
+    return float(0.5 * np.sum(m * np.sum(scene.vel[:nm] ** 2, axis=1)) + 0.5 * np.sum(inertia * scene.spin[:nm] ** 2))
