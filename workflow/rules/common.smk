@@ -1,0 +1,64 @@
+# Helpers shared by the per-figure rule files (workflow/rules/<figure>.smk).
+#
+# Conventions of a figure <fig> (see workflow/README.md):
+#   config section  config[<fig>], validated by workflow/schemas/<fig>.schema.yaml
+#   data            results/<fig>/*.nc (simulation, exploration shards, merged ensembles)
+#   notebook        notebooks/<fig>.ipynb (paired with notebooks/<fig>.py), run by a
+#                   `notebook:` rule writing results/figures/<fig>.png and .pdf;
+#                   its executed copy goes to results/notebooks/<fig>.ipynb and the
+#                   generic rule `render_html` turns it into results/html/<fig>.html
+#   logs, benches   results/logs/<fig>/<rule>*.log, results/benchmarks/<fig>/<rule>*.tsv
+import glob
+from pathlib import Path
+
+from snakemake.utils import validate
+
+ROOT = Path(workflow.basedir)
+
+# Figures in the order of the paper; each has a rules file and a config section.
+FIGURES = [f for f in ("fig1_wedged", "fig2_slope", "fig3_equilibrium", "fig4_pile")
+           if (ROOT / "workflow" / "rules" / f"{f}.smk").exists() and f in config]
+
+# Every source file of the solver: a change in ncd/ reruns simulations and explorations.
+NCD_SOURCES = sorted(str(p) for p in (ROOT / "ncd").rglob("*.py"))
+
+
+def section(figure):
+    """The validated config section of a figure (validated once, on first use)."""
+    validate(config[figure], str(ROOT / "workflow" / "schemas" / f"{figure}.schema.yaml"))
+    return config[figure]
+
+
+def shard_files(figure, name, n_shards):
+    """Shard files of ensemble ``name``: results/<fig>/shards/<name>_<k>-of-<n>.nc."""
+    return [f"results/{figure}/shards/{name}_{k}-of-{n_shards}.nc" for k in range(n_shards)]
+
+
+def figure_targets(figure):
+    return [f"results/html/{figure}.html", f"results/figures/{figure}.png",
+            f"results/figures/{figure}.pdf"]
+
+
+def log(figure, rule_name):
+    return f"results/logs/{figure}/{rule_name}.log"
+
+
+def bench(figure, rule_name):
+    return f"results/benchmarks/{figure}/{rule_name}.tsv"
+
+
+rule render_html:
+    """Render an executed notebook (written by its figure's notebook rule) to HTML."""
+    input:
+        png="results/figures/{figure}.png",
+    output:
+        html="results/html/{figure}.html",
+    params:
+        executed="results/notebooks/{figure}.ipynb",
+    log:
+        "results/logs/{figure}/render_html.log",
+    benchmark:
+        "results/benchmarks/{figure}/render_html.tsv"
+    shell:
+        "jupyter nbconvert --to html --output-dir results/html --output {wildcards.figure} "
+        "{params.executed} > {log} 2>&1"
