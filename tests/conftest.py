@@ -1,11 +1,13 @@
 """Shared fixtures: one run of the whole Snakemake DAG on a reduced configuration.
 
-The DAG runs once per test session in a temporary directory, with
+The workflow files are copied to a temporary directory (so that tests may touch
+them) and the DAG runs there once per test session, with
 ``tests/config_reduced.yaml`` overlaid on ``config.yaml``.  Set
 ``NCD_RESULTS_DIR`` to a directory where ``snakemake -j2`` already ran (e.g. the
 repository itself) to check the full-size figure data instead.
 """
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -13,24 +15,47 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
-REDUCED = ROOT / "tests" / "config_reduced.yaml"
+WORKFLOW_FILES = ("Snakefile", "config.yaml", "workflow", "notebooks", "ncd", "tests/config_reduced.yaml")
 
 
-def run_snakemake(workdir, *args, configfiles=(REDUCED,), check=True):
-    """Run the workflow of this repository in ``workdir``; returns the CompletedProcess."""
-    cmd = [sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "-d", str(workdir),
-           "--configfile", str(ROOT / "config.yaml"), *map(str, configfiles), *args]
-    proc = subprocess.run(cmd, capture_output=True, text=True)
+def copy_workflow(dst):
+    """Copy the files the DAG reads into ``dst``; returns ``dst``."""
+    for name in WORKFLOW_FILES:
+        src = ROOT / name
+        target = dst / name
+        target.parent.mkdir(parents=True, exist_ok=True)
+        if src.is_dir():
+            shutil.copytree(src, target, ignore=shutil.ignore_patterns("__pycache__", "*.nbi", "*.nbc"))
+        else:
+            shutil.copy2(src, target)
+    return dst
+
+
+def run_snakemake(repo, *args, extra_configs=(), check=True, workdir=None):
+    """Run the workflow copied in ``repo`` (reduced config plus ``extra_configs``)."""
+    configs = [repo / "config.yaml", repo / "tests" / "config_reduced.yaml", *extra_configs]
+    cmd = [sys.executable, "-m", "snakemake", "-s", str(repo / "Snakefile"), "-d", str(workdir or repo),
+           "--configfile", *map(str, configs), *args]
+    env = dict(os.environ)
+    # the notebook rules call jupyter: make this interpreter's scripts reachable
+    env["PATH"] = os.path.dirname(sys.executable) + os.pathsep + env.get("PATH", "")
+    proc = subprocess.run(cmd, capture_output=True, text=True, env=env)
     if check and proc.returncode != 0:
         raise AssertionError(f"snakemake failed ({' '.join(cmd)}):\n{proc.stdout[-4000:]}\n{proc.stderr[-8000:]}")
     return proc
 
 
 @pytest.fixture(scope="session")
-def results(tmp_path_factory):
+def dag_repo(tmp_path_factory):
+    """A copy of the workflow in which the reduced DAG has run completely."""
+    repo = copy_workflow(tmp_path_factory.mktemp("repo"))
+    run_snakemake(repo, "-j2")
+    return repo
+
+
+@pytest.fixture(scope="session")
+def results(request):
     """Directory holding ``results/`` of a full DAG run (reduced config unless NCD_RESULTS_DIR)."""
     if os.environ.get("NCD_RESULTS_DIR"):
         return Path(os.environ["NCD_RESULTS_DIR"]) / "results"
-    workdir = tmp_path_factory.mktemp("dag")
-    run_snakemake(workdir, "-j2")
-    return workdir / "results"
+    return request.getfixturevalue("dag_repo") / "results"
