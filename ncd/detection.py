@@ -4,7 +4,9 @@ Discs are binned by a counting sort into square cells at least one largest
 diameter plus the alert distance wide; each disc is compared with the discs of
 its own cell and of four neighbour cells (half stencil).  Along a periodic x the
 cell indices wrap and the pair distance uses the minimum image (the period is
-at least three cells, checked by :func:`ncd.scene.make_scene`).
+at least three largest diameters, checked by :func:`ncd.scene.make_scene`;
+should an alert distance leave fewer than three columns, duplicate pairs are
+removed).
 """
 import numpy as np
 from numba import njit
@@ -34,7 +36,9 @@ def _grid_pairs(pos, radius, n_mobile, alert, period, cell, out_a, out_b, out_sh
     cell_of = np.empty(n, np.int64)
     counts = np.zeros(nx * ny + 1, np.int64)
     for i in range(n):
-        cx = int((pos[i, 0] - x0) / cx_size)
+        # floor, not int(): along a periodic x a middle configuration may lie
+        # slightly left of 0 and must wrap into the last column
+        cx = int(np.floor((pos[i, 0] - x0) / cx_size))
         if period > 0.0:
             cx = cx % nx
         cx = min(max(cx, 0), nx - 1)
@@ -104,5 +108,14 @@ def disc_pairs(pos, radius, n_mobile, alert=0.0, period=0.0):
         shift = np.empty(cap)
         count = _grid_pairs(pos, radius, n_mobile, float(alert), float(period), cell, a, b, shift)
         if count <= cap:
-            return a[:count], b[:count], shift[:count]
+            break
         cap = count
+    a, b, shift = a[:count], b[:count], shift[:count]
+    if period > 0.0 and int(period / cell) < 3:
+        # fewer than three columns across the period: the wrapped stencil meets
+        # some cell pairs twice (and a cell with itself); keep each pair once
+        keep = np.nonzero(a != b)[0]
+        _, first = np.unique(a[keep] * n + b[keep], return_index=True)
+        keep = keep[np.sort(first)]
+        a, b, shift = a[keep], b[keep], shift[keep]
+    return a, b, shift

@@ -67,21 +67,24 @@ class NLGSResult:
         return self.impulse[:, 1]
 
 
-@njit(cache=True)
-def _iterate(sweep, residual, data, order, status, scale, tol, max_sweeps, criterion, check_every):
-    """The NLGS driver: sweeps until the criterion holds or ``max_sweeps``."""
-    tiny = 1e-300
-    change = np.inf
-    res = np.inf
-    for k in range(1, max_sweeps + 1):
-        dsum, ssum = sweep(data, order, status)
-        change = dsum / max(ssum, tiny) if ssum > 0.0 else 0.0
-        if k % check_every == 0 or k == max_sweeps or (criterion == 1 and change <= tol):
-            rsq, ssq = residual(data)
-            res = np.sqrt(rsq) / max(scale, np.sqrt(ssq), tiny)
-            if (criterion == 0 and res <= tol) or (criterion == 1 and change <= tol):
-                return k, res, change, True
-    return max_sweeps, res, change, False
+# The drivers below are written once per form on purpose: passing the sweep and
+# residual functions as arguments to one cached driver keys numba's on-disk cache
+# on the dispatcher objects of the current process, so every process recompiled
+# the driver, appended one more entry to the cache index, and eventually failed
+# to pickle the index ("underlying object has vanished").
+@njit(cache=True, inline="always")
+def _check_now(k, change, tol, max_sweeps, criterion, check_every):
+    return k % check_every == 0 or k == max_sweeps or (criterion == 1 and change <= tol)
+
+
+@njit(cache=True, inline="always")
+def _relative(dsum, ssum):
+    return dsum / max(ssum, 1e-300) if ssum > 0.0 else 0.0
+
+
+@njit(cache=True, inline="always")
+def _done(res, change, tol, criterion):
+    return (criterion == 0 and res <= tol) or (criterion == 1 and change <= tol)
 
 
 # ---------------------------------------------------------------- disc form
@@ -132,6 +135,22 @@ def _residual_discs(data):
     return rsq, ssq
 
 
+@njit(cache=True)
+def _iterate_discs(data, order, status, scale, tol, max_sweeps, criterion, check_every):
+    """The NLGS driver (disc form): sweeps until the criterion holds or ``max_sweeps``."""
+    change = np.inf
+    res = np.inf
+    for k in range(1, max_sweeps + 1):
+        dsum, ssum = _sweep_discs(data, order, status)
+        change = _relative(dsum, ssum)
+        if _check_now(k, change, tol, max_sweeps, criterion, check_every):
+            rsq, ssq = _residual_discs(data)
+            res = np.sqrt(rsq) / max(scale, np.sqrt(ssq), 1e-300)
+            if _done(res, change, tol, criterion):
+                return k, res, change, True
+    return max_sweeps, res, change, False
+
+
 def _scale(q, W):
     """``|rho q|`` with ``rho_alpha = 1 / W_alpha,nn``: the impulse scale of the problem."""
     return float(np.sqrt(np.sum((q / W[:, 0, 0][:, None]) ** 2)))
@@ -172,9 +191,9 @@ def solve_discs(scene, contacts, vel, spin, guess=None, review_order=None,
                    impulse, vel, spin)
     data = (c.body_a, c.body_b, c.normal, c.arm_a, c.arm_b, W, c.mu, bias,
             scene.inv_mass, scene.inv_inertia, vel, spin, impulse)
-    sweeps, res, change, ok = _iterate(_sweep_discs, _residual_discs, data, order, status,
-                                       _scale(q_free, W), settings.tol, settings.max_sweeps,
-                                       CRITERIA[settings.criterion], settings.check_every)
+    sweeps, res, change, ok = _iterate_discs(data, order, status, _scale(q_free, W), settings.tol,
+                                             settings.max_sweeps, CRITERIA[settings.criterion],
+                                             settings.check_every)
     return NLGSResult(impulse, status, int(sweeps), float(res), float(change), bool(ok))
 
 
@@ -220,6 +239,22 @@ def _residual_local(data):
     return rsq, ssq
 
 
+@njit(cache=True)
+def _iterate_local(data, order, status, scale, tol, max_sweeps, criterion, check_every):
+    """The NLGS driver (local form): sweeps until the criterion holds or ``max_sweeps``."""
+    change = np.inf
+    res = np.inf
+    for k in range(1, max_sweeps + 1):
+        dsum, ssum = _sweep_local(data, order, status)
+        change = _relative(dsum, ssum)
+        if _check_now(k, change, tol, max_sweeps, criterion, check_every):
+            rsq, ssq = _residual_local(data)
+            res = np.sqrt(rsq) / max(scale, np.sqrt(ssq), 1e-300)
+            if _done(res, change, tol, criterion):
+                return k, res, change, True
+    return max_sweeps, res, change, False
+
+
 def solve_local(W, q, mu, guess=None, review_order=None, settings=SolverSettings()):
     """NLGS on a 2-D frictional contact problem in local form.
 
@@ -244,7 +279,7 @@ def solve_local(W, q, mu, guess=None, review_order=None, settings=SolverSettings
     order = np.arange(n) if review_order is None else np.asarray(review_order, dtype=np.int64)
     status = np.zeros(n, np.int8)
     data = (Wc.indptr.astype(np.int64), Wc.indices.astype(np.int64), Wc.data, q, Wd, mu, flat)
-    sweeps, res, change, ok = _iterate(_sweep_local, _residual_local, data, order, status,
-                                       _scale(q.reshape(n, 2), Wd), settings.tol, settings.max_sweeps,
-                                       CRITERIA[settings.criterion], settings.check_every)
+    sweeps, res, change, ok = _iterate_local(data, order, status, _scale(q.reshape(n, 2), Wd),
+                                             settings.tol, settings.max_sweeps,
+                                             CRITERIA[settings.criterion], settings.check_every)
     return NLGSResult(flat.reshape(n, 2), status, int(sweeps), float(res), float(change), bool(ok))

@@ -9,7 +9,8 @@ def _finite(name, value):
     arr = np.asarray(value, dtype=float)
     if not np.all(np.isfinite(arr)):
         bad = np.argwhere(~np.isfinite(arr))[0]
-        raise InputError(f"{name} must be finite; {name}{list(bad)} = {arr[tuple(bad)]}")
+        where = ", ".join(str(int(i)) for i in bad)
+        raise InputError(f"{name} must be finite; {name}[{where}] = {arr[tuple(bad)]}")
     return arr
 
 

@@ -73,6 +73,10 @@ def prepare_step(scene, h, theta=0.5, gap_tolerance=None, vel=None, spin=None):
     pos_mid = scene.pos.copy()
     pos_mid[:nm] += (1.0 - theta) * h * vel[:nm]
     angle_mid = scene.angle + (1.0 - theta) * h * spin
+    if not (np.all(np.isfinite(pos_mid)) and np.all(np.isfinite(angle_mid))):
+        # a non-finite state would otherwise reach the detection grid
+        raise SimulationError(f"state is non-finite at t = {scene.time:.6g} (positions, angles "
+                              f"or velocities): cannot build the step")
     contacts = detect_contacts(scene, alert=gap_tol, pos=pos_mid)
     W = delassus_blocks(contacts.body_a, contacts.body_b, contacts.arm_a, contacts.arm_b,
                         scene.inv_mass, scene.inv_inertia)

@@ -16,7 +16,8 @@ from snakemake.utils import validate
 ROOT = Path(workflow.basedir)
 
 # Figures in the order of the paper; each has a rules file and a config section.
-FIGURES = [f for f in ("fig1_wedged", "fig2_slope", "fig3_equilibrium", "fig4_pile")
+FIGURES = [f for f in ("fig1_wedged", "fig2_slope", "fig3_equilibrium", "fig4_pile",
+                       "stability", "error_vs_runtime")
            if (ROOT / "workflow" / "rules" / f"{f}.smk").exists() and f in config]
 
 # Every source file of the solver: a change in ncd/ reruns simulations and explorations.

@@ -1,0 +1,240 @@
+"""Figure 2 (section 3): spread measures on synthetic clouds, and the figure data.
+
+The figure-data tests read ``results/fig2_slope`` of a DAG run (the reduced
+configuration unless ``NCD_RESULTS_DIR`` points at a full run) and recompute
+what they check from the raw ensemble, not from ``measures.nc``.
+"""
+import json
+
+import numpy as np
+import pytest
+import xarray as xr
+import yaml
+
+import ncd
+from ncd.figures import slope
+from ncd.figures import slope_analysis as sa
+
+
+# ------------------------------------------------------------------ measures
+def rotation(deg):
+    t = np.radians(deg)
+    return np.array([[np.cos(t), -np.sin(t)], [np.sin(t), np.cos(t)]])
+
+
+def test_cloud_stats_exact_on_a_cross():
+    # (+-a, 0), (0, +-b) rotated by 30°: covariance diag(a^2/2, b^2/2) in the rotated frame
+    a, b = 3.0, 0.5
+    pts = np.array([[a, 0], [-a, 0], [0, b], [0, -b]]) @ rotation(30.0).T + [1.0, -2.0]
+    s = sa.cloud_stats(pts[:, 0], pts[:, 1])
+    assert s["mean_x"] == pytest.approx(1.0) and s["mean_y"] == pytest.approx(-2.0)
+    assert s["major"] == pytest.approx(a / np.sqrt(2), rel=1e-12)
+    assert s["minor"] == pytest.approx(b / np.sqrt(2), rel=1e-12)
+    assert s["ratio"] == pytest.approx(b / a, rel=1e-12)
+    assert s["spread"] == pytest.approx(np.sqrt((a * a + b * b) / 2), rel=1e-12)
+    assert s["angle"] == pytest.approx(30.0, abs=1e-9)
+
+
+@pytest.mark.parametrize("deg", [-89.0, -45.0, 0.0, 24.0, 90.0])
+def test_cloud_stats_principal_axes_of_a_gaussian_cloud(deg):
+    rng = np.random.default_rng(3)
+    pts = rng.normal(size=(20000, 2)) * [2.0, 0.2] @ rotation(deg).T
+    s = sa.cloud_stats(pts[:, 0], pts[:, 1])
+    assert s["major"] == pytest.approx(2.0, rel=0.03)
+    assert s["minor"] == pytest.approx(0.2, rel=0.03)
+    assert s["ratio"] == pytest.approx(0.1, rel=0.05)
+    diff = (s["angle"] - deg + 90.0) % 180.0 - 90.0   # an axis, defined modulo 180°
+    assert abs(diff) < 1.0
+    assert -90.0 < s["angle"] <= 90.0
+
+
+def test_cloud_stats_vectorized_matches_numpy_cov():
+    rng = np.random.default_rng(4)
+    x, y = rng.normal(size=(2, 3, 5, 50))
+    y = y + 0.7 * x
+    s = sa.cloud_stats(x, y)
+    for i in range(3):
+        for j in range(5):
+            c = np.cov(x[i, j], y[i, j], bias=True)
+            w = np.linalg.eigvalsh(c)
+            assert s["cov_xy"][i, j] == pytest.approx(c[0, 1], rel=1e-10)
+            assert s["major"][i, j] == pytest.approx(np.sqrt(w[1]), rel=1e-10)
+            assert s["minor"][i, j] == pytest.approx(np.sqrt(w[0]), rel=1e-9)
+
+
+def test_cloud_stats_of_a_segment_and_of_a_point():
+    t = np.linspace(-1, 1, 11)
+    s = sa.cloud_stats(2 * t, -t)           # on the line y = -x/2
+    assert s["minor"] < 1e-12 and s["ratio"] < 1e-12
+    assert s["angle"] == pytest.approx(np.degrees(np.arctan2(-1, 2)), abs=1e-9)
+    p = sa.cloud_stats(np.ones(5), np.ones(5))
+    assert p["spread"] == 0.0 and np.isnan(p["ratio"])
+
+
+def test_solutions_groups_runs_by_field():
+    rng = np.random.default_rng(5)
+    centres = rng.normal(size=(3, 40))
+    pick = np.array([0] * 7 + [1] * 2 + [2] * 11)
+    rng.shuffle(pick)
+    fields = centres[pick] + rng.uniform(-1e-4, 1e-4, size=(len(pick), 40))
+    labels, reps = sa.solutions(fields, 1e-3)
+    assert np.bincount(labels).tolist() == [11, 7, 2]          # most frequent first
+    for k in range(3):                                          # a label is one original group
+        assert len(set(pick[labels == k])) == 1
+        assert labels[reps[k]] == k
+    one, _ = sa.solutions(fields, 100.0)
+    assert (one == 0).all()
+
+
+def test_verdict_rules():
+    tol = [1e-4, 1e-5, 1e-6, 1e-7, 1e-8]
+    plateau = [0.9, 1.0, 1.0, 1.0, 1.0]
+    shrinking = [1.0, 0.1, 0.01, 1e-3, 1e-4]
+    assert sa.verdict(tol, plateau, shrinking, floor=0.1)[0] == "indeterminacy"
+    assert sa.verdict(tol, shrinking, shrinking, floor=0.1)[0] == "iteration error"
+    # a plateau that the warm-start runs share is not the paper's contrast
+    assert sa.verdict(tol, plateau, plateau, floor=0.1)[0] == "undecided"
+    # a plateau below the floor is not an indeterminacy
+    assert sa.verdict(tol, [1e-3] * 5, shrinking, floor=0.1)[0] == "undecided"
+    with pytest.raises(ValueError, match="decades"):
+        sa.verdict([1e-6, 1e-7], [1, 1], [0, 0], floor=0.1)
+
+
+def test_rigid_clusters_and_switch_distance():
+    # grains 0-1-2 stick in a chain, 3-4 stick, 2-3 slides, 4 sticks to the ground (index 5)
+    a = np.array([0, 1, 2, 3, 4])
+    b = np.array([1, 2, 3, 4, 5])
+    stick = np.array([True, True, False, True, True])
+    labels = sa.rigid_clusters(5, a, b, stick)
+    assert labels[0] == labels[1] == labels[2] != labels[3] == labels[4]
+    dist = sa._switch_distance(5, a, b, stick, [0])
+    assert dist.tolist() == [0, 1, 2, -1, -1]
+
+
+def test_cluster_motion_fit_recovers_a_rigid_motion():
+    rng = np.random.default_rng(6)
+    pos = rng.uniform(0, 1, size=(6, 2))
+    labels = np.array([0, 0, 0, 1, 1, 1])
+    dv, dw = np.array([[0.3, -0.1], [1.0, 2.0]]), np.array([2.0, -1.0])
+    delta = np.zeros_like(pos)
+    for k in (0, 1):
+        m = labels == k
+        c = pos[m].mean(0)
+        r = pos[m] - c
+        delta[m] = dv[k] + dw[k] * np.column_stack([-r[:, 1], r[:, 0]])
+    fit, size = sa.cluster_motion_fit(pos, delta, labels)
+    np.testing.assert_allclose(fit, delta, atol=1e-12)
+    assert size.tolist() == [3] * 6
+
+
+# ------------------------------------------------------------------ figure data
+@pytest.fixture(scope="module")
+def data(results):
+    base = results / "fig2_slope"
+    traj = xr.load_dataset(base / "trajectory.nc")
+    ens = xr.load_dataset(base / "ensemble.nc")
+    meas = xr.load_dataset(base / "measures.nc")
+    cfg = yaml.safe_load(ens.attrs["config_yaml"])
+    an = yaml.safe_load(meas.attrs["config_yaml"])
+    return traj, ens, meas, cfg, an
+
+
+def raw_spread(ens, init, disc):
+    """RMS distance to the mean of one grain's cloud, per tolerance, from the raw data."""
+    e = ens.sel(init=init, disc=disc)
+    return np.sqrt(e.accel_x.var("run") + e.accel_y.var("run")).values
+
+
+def test_every_run_converged_to_its_tolerance(data):
+    _, ens, _, cfg, _ = data
+    assert ens.sizes["run"] == cfg["explore"]["runs"]
+    assert list(ens.init.values) == ["zero", "warm"]
+    assert bool(ens.converged.all()), "some runs did not converge: raise explore.max_sweeps"
+    tol = ens.tol.broadcast_like(ens.residual)
+    assert bool((ens.residual <= tol).all())
+    assert bool((ens.sweeps.diff("tol") >= 0).all()) and bool((ens.wall_time.diff("tol") >= 0).all())
+    np.testing.assert_array_equal(ens.run.values, np.arange(cfg["explore"]["runs"]))
+
+
+def test_spread_against_tolerance_supports_the_verdict(data):
+    _, ens, meas, _, an = data
+    grain, verdict = int(meas.attrs["grain"]), meas.attrs["verdict"]
+    g = float(meas.attrs["g"])
+    tol = ens.tol.values
+    zero, warm = raw_spread(ens, "zero", grain), raw_spread(ens, "warm", grain)
+    np.testing.assert_allclose(meas.spread.sel(init="zero", disc=grain), zero, rtol=1e-9)
+    window = tol <= tol.min() * 10 ** an["decades"] * (1 + 1e-9)
+    assert np.log10(tol[window].max() / tol.min()) >= 2 - 1e-9, "the tolerances must span two decades"
+    if verdict == "indeterminacy":
+        assert (zero[window] >= an["floor"] * g).all(), zero
+        assert zero[-1] >= 0.5 * zero[window][0], "the zero-guess spread must not shrink with the tolerance"
+        assert zero[-1] >= 10 * warm[-1], (zero[-1], warm[-1])
+        assert meas.attrs["n_solutions"] >= 2
+    elif verdict == "iteration error":
+        assert zero[-1] <= 0.1 * zero[window][0], zero
+    else:
+        pytest.fail(f"no decisive verdict ({verdict}): choose another step in config (flow.step)")
+    # the rule that chose the grain
+    if an["grain"] < 0:
+        every = np.sqrt(ens.sel(init="zero", tol=tol.min()).accel_x.var("run")
+                        + ens.sel(init="zero", tol=tol.min()).accel_y.var("run")).values
+        assert grain == int(np.argmax(every))
+
+
+def test_the_notebook_states_the_verdict_and_the_cloud_shape(data, results):
+    _, ens, meas, _, an = data
+    nb = json.loads((results / "notebooks" / "fig2_slope.ipynb").read_text())
+    text = "".join("".join(o.get("text", "")) for c in nb["cells"] if c["cell_type"] == "code"
+                   for o in c.get("outputs", []))
+    assert f"VERDICT: {meas.attrs['verdict']}." in text
+    grain = int(meas.attrs["grain"])
+    ratio = float(meas.ratio.sel(init="zero", tol=ens.tol.min(), disc=grain))
+    assert f"minor/major {ratio:.2e}" in text
+
+
+def test_the_chosen_grain_cloud_is_a_line(data):
+    _, ens, meas, _, an = data
+    grain = int(meas.attrs["grain"])
+    e = ens.sel(init="zero", tol=ens.tol.min(), disc=grain)
+    c = np.cov(e.accel_x.values, e.accel_y.values, bias=True)
+    w = np.linalg.eigvalsh(c)
+    ratio = np.sqrt(max(w[0], 0.0) / w[1])
+    assert ratio == pytest.approx(float(meas.ratio.sel(init="zero", tol=ens.tol.min(), disc=grain)), rel=1e-6, abs=1e-9)
+    assert ratio < an["line_ratio"], f"minor/major = {ratio:.3g}: not a line"
+
+
+def test_the_flow_is_accelerating_at_the_investigated_step(data):
+    traj, _, _, _, _ = data
+    k = int(traj.attrs["investigated_step"])
+    i = k - 1
+    vx = traj.mean_vx.values
+    assert vx[i] > 0
+    # a phase of overall acceleration: the mean velocity grows over +-10 steps (the
+    # step itself may hold a collision) and so does the kinetic energy
+    lo, hi = max(0, i - 10), min(len(vx), i + 11)
+    slope_fit = np.polyfit(traj.time.values[lo:hi], vx[lo:hi], 1)[0]
+    assert slope_fit > 0.01 * float(np.hypot(traj.attrs["gravity_x"], traj.attrs["gravity_y"]))
+    assert traj.kinetic_energy.values[i] > traj.kinetic_energy.values[lo]
+    assert vx[hi - 1] > vx[lo]
+
+
+def test_the_restart_reproduces_the_trajectory_step(data):
+    """Rebuilt state + previous impulses + the flow's settings give the trajectory's own step."""
+    traj, _, _, cfg, _ = data
+    scene = slope.scene_at_step(traj, cfg)
+    problem = ncd.prepare_step(scene, float(traj.attrs["h"]))
+    guess = ncd.stepper.initial_guess(scene, problem, "warm")
+    assert np.count_nonzero(guess[:, 0]) > 0.5 * problem.contacts.n
+    settings = ncd.SolverSettings(**cfg["flow"]["solver"])
+    result, vel, _ = ncd.solve_problem(scene, problem, guess, None, settings)
+    acc = (vel[: scene.n_mobile] - scene.vel[: scene.n_mobile]) / problem.h
+    np.testing.assert_allclose(acc[:, 0], traj.reference_accel_x, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(acc[:, 1], traj.reference_accel_y, rtol=0, atol=1e-9)
+
+
+def test_a_member_does_not_depend_on_its_shard(data):
+    traj, ens, _, cfg, _ = data
+    member = int(ens.run.values[-1])
+    alone = slope.run_ensemble(traj, cfg, [member])
+    for v in ("accel_x", "accel_y", "sweeps", "residual", "converged", "impulse_n", "impulse_t", "status"):
+        np.testing.assert_array_equal(alone[v].sel(run=member).values, ens[v].sel(run=member).values, err_msg=v)

@@ -1,0 +1,228 @@
+"""Figure 4 (Moreau 2005, section 5): the pile poured from a localized source.
+
+Unit tests of the cut resultant and the ground measures on hand-built cases,
+then checks on the figure data of a whole-DAG run (fixture ``results``).
+"""
+import numpy as np
+import pytest
+import xarray as xr
+import yaml
+
+import ncd
+from ncd.contacts import Contacts, h_matrix, match_warm
+from ncd.figures import cuts as cm
+from ncd.figures import pile
+
+# Stated bounds of the figure-data tests
+MAX_DEVIATION_DEG = 10.0     # resultant across the default cut vs the free-surface slope
+WEIGHT_TOL = 1e-6            # history forces: ground reaction vs weight (relative)
+MOMENTUM_TOL = 1e-6          # every run: ground_fy - weight = sum m u_f,y / h (relative to the weight)
+RUN_WEIGHT_TOL = 1e-2        # every converged zero-guess run: ground reaction vs weight (relative)
+
+
+# ------------------------------------------------------------------ unit tests
+def _contacts(body_a, body_b, normal, point):
+    n = len(body_a)
+    return Contacts(body_a=np.array(body_a), body_b=np.array(body_b), normal=np.array(normal, float),
+                    point=np.array(point, float), gap=np.zeros(n), arm_a=np.ones(n), arm_b=np.ones(n),
+                    shift_b=np.zeros(n), key=np.arange(n), mu=np.full(n, 0.5), e_n=np.zeros(n), e_t=np.zeros(n))
+
+
+def test_cut_resultant_of_one_contact_by_hand():
+    # grain 0 at x = 1, grain 1 at x = -1; normal from b = 1 to a = 0 is +x, tangent +y
+    pos = np.array([[1.0, 1.0], [-1.0, 1.0]])
+    c = _contacts([0], [1], [[1.0, 0.0]], [[0.0, 1.0]])
+    s = np.array([[2.0, 0.5]])                       # force on grain 0: (2, 0.5) / h = (4, 1)
+    F, n = cm.cut_resultant(c, s, pos, 2, 0.0, +1, h=0.5)
+    np.testing.assert_allclose(F, [4.0, 1.0], rtol=1e-14)
+    assert n == 1
+    F, n = cm.cut_resultant(c, s, pos, 2, 0.0, -1, h=0.5)   # bank on the left: the force on grain 1
+    np.testing.assert_allclose(F, [-4.0, -1.0], rtol=1e-14)
+    assert cm.cut_resultant(c, s, pos, 2, 2.0, +1, h=0.5)[1] == 0           # the cut crosses nothing
+    assert cm.cut_resultant(c, s, pos, 2, 0.0, +1, h=0.5, y_lo=1.5)[1] == 0  # crossing below the segment
+    with pytest.raises(ValueError, match="outer"):
+        cm.cut_resultant(c, s, pos, 2, 0.0, 0)
+
+
+def test_cut_ignores_ground_contacts_and_uses_the_crossing_height():
+    # grain 0 (x = 0.5, y = 1) on ground disc 2 (x = -0.5, y = 0); grains 0 and 1 (x = -0.5, y = 3)
+    pos = np.array([[0.5, 1.0], [-0.5, 3.0], [-0.5, 0.0]])
+    nrm = [(pos[0] - pos[2]) / np.linalg.norm(pos[0] - pos[2]), (pos[0] - pos[1]) / np.linalg.norm(pos[0] - pos[1])]
+    c = _contacts([0, 0], [2, 1], nrm, [[0, 0.5], [0, 2]])
+    sign, y = cm.cut_weights(c, pos, 2, 0.0, +1)
+    np.testing.assert_array_equal(sign, [0, 1])
+    assert y[1] == pytest.approx(2.0, abs=1e-14)     # midpoint of the centre line
+    assert cm.cut_weights(c, pos, 2, 0.0, +1, y_hi=1.9)[0].tolist() == [0, 0]
+
+
+@pytest.fixture(scope="module")
+def little_pile():
+    """Six grains at rest on a rough ground: forces of the (warm) equilibrium test."""
+    r = 0.5
+    ground = np.column_stack([np.arange(-2.5, 2.51, 1.0), np.zeros(6)])      # grains sit in the valleys
+    y = np.sqrt(0.75)
+    pos = [[-1.0, y], [0.0, y], [1.0, y], [-0.5, 2 * y], [0.5, 2 * y], [0.0, 3 * y]]
+    scene = ncd.make_scene(pos, r, 1.0, obstacle_pos=ground, obstacle_radius=r, mu=0.5, overlap_tolerance=0.5)
+    for _ in range(300):
+        ncd.step(scene, 1e-3, settings=ncd.SolverSettings(tol=1e-10))
+    eq = ncd.equilibrium_test(scene, 1e-3, settings=ncd.SolverSettings(tol=1e-12, max_sweeps=100000), init="warm")
+    assert eq.at_rest
+    return scene, eq
+
+
+@pytest.mark.parametrize("x_cut, outer", [(0.25, +1), (-0.25, -1), (0.7, +1), (-0.7, -1)])
+def test_cut_resultant_balances_the_bank(little_pile, x_cut, outer):
+    """The force across the cut, the ground reaction and the weight of the bank sum to zero."""
+    scene, eq = little_pile
+    c, nm = eq.contacts, scene.n_mobile
+    F, n = cm.cut_resultant(c, eq.forces, scene.pos, nm, x_cut, outer)
+    assert n >= 2
+    bank = np.nonzero(np.where(scene.pos[:nm, 0] >= x_cut, 1, -1) == outer)[0]
+    ground = np.isin(c.body_a, bank) & (c.body_b >= nm)
+    ex, ey = cm.contact_force_components(c)
+    G = np.array([np.sum(ex[ground] * eq.forces[ground]), np.sum(ey[ground] * eq.forces[ground])])
+    W = scene.mass[bank].sum() * scene.gravity
+    np.testing.assert_allclose(F + G + W, 0.0, atol=1e-8 * np.linalg.norm(W))
+    assert np.linalg.norm(F) > 1e-3 * np.linalg.norm(W)
+
+
+def test_ground_matrix_total_and_bins(little_pile):
+    scene, eq = little_pile
+    nm = scene.n_mobile
+    edges = np.linspace(-4.0, 4.0, 9)
+    g = cm.ground_matrix(eq.contacts, nm, edges) @ eq.forces.ravel()
+    weight = scene.mass[:nm].sum() * 9.81
+    assert g[1] == pytest.approx(weight, rel=1e-8)
+    assert abs(g[0]) < 1e-8 * weight
+    assert g[2:].sum() == pytest.approx(g[1], rel=1e-12)
+    c, f = eq.contacts, eq.forces
+    by_hand = np.zeros(len(edges) - 1)
+    for k in range(c.n):
+        if c.body_b[k] >= nm:                          # a ground disc
+            fy = f[k, 0] * c.normal[k, 1] + f[k, 1] * c.normal[k, 0]      # t_y = n_x
+            by_hand[int(np.floor(c.point[k, 0] - edges[0]))] += fy
+    np.testing.assert_allclose(g[2:], by_hand, rtol=1e-12, atol=1e-12 * weight)
+    assert np.count_nonzero(by_hand) >= 2
+
+
+def test_surface_fit_recovers_a_triangle():
+    x = np.linspace(-20.0, 20.0, 81)
+    height = np.maximum(0.0, 8.0 - np.abs(x) * np.tan(np.radians(22.0)))
+    fits = cm.fit_flanks(x, height, 0.0, (0.2, 0.8))
+    for side in ("left", "right"):
+        assert fits[side]["angle"] == pytest.approx(22.0, abs=1e-9)
+        assert abs(fits[side]["toe"]) == pytest.approx(8.0 / np.tan(np.radians(22.0)), rel=1e-9)
+    phi, dev = cm.flank_angles(np.cos(np.radians(22.0)), -np.sin(np.radians(22.0)), +1, 22.0)
+    assert phi == pytest.approx(22.0) and dev == pytest.approx(0.0, abs=1e-12)
+
+
+def test_warm_memory_survives_pouring(little_pile):
+    """Appending grains keeps the warm-start impulses of the persisting contacts."""
+    scene, _ = little_pile
+    cfg = {"grains": {"density": 1.0}, "gravity": 9.81, "mu": 0.5, "mu_ground": 0.5,
+           "construction": {"overlap_tolerance": 0.5}}
+    nm = scene.n_mobile
+    pos = np.vstack([scene.pos[:nm], [[5.0, 3.0]]])
+    new = pile.pile_scene(cfg, pos, np.append(scene.radius[:nm], 0.5), scene.pos[nm:], scene.radius[nm:])
+    pile.carry_warm(scene, new)
+    old = ncd.detect_contacts(scene, 1e-9)
+    now = ncd.detect_contacts(new, 1e-9)
+    np.testing.assert_array_equal(match_warm(now, new.prev_keys, new.prev_impulse),
+                                  match_warm(old, scene.prev_keys, scene.prev_impulse))
+
+
+# ------------------------------------------------------------------ figure data
+@pytest.fixture(scope="module")
+def data(results):
+    d = results / "fig4_pile"
+    out = {n: xr.load_dataset(d / f"{n}.nc") for n in ("construction", "cuts", "ensemble", "tolerance")}
+    out["cfg"] = yaml.safe_load(out["construction"].attrs["config_yaml"])
+    return out
+
+
+def _final(data):
+    cfg = data["cfg"]
+    scene = pile.final_scene(cfg, data["construction"])
+    problem = pile.equilibrium_problem(cfg, scene, data["construction"])
+    return scene, problem
+
+
+def test_final_state_is_an_equilibrium(data):
+    """History forces balance gravity on every grain and obey Coulomb's law; the stored
+    equilibrium test passed."""
+    con = data["construction"]
+    assert con.attrs["at_rest"] == 1 and con.attrs["eq_converged"] == 1
+    assert con.attrs["eq_max_velocity"] <= data["cfg"]["construction"]["velocity_tol"]
+    assert con.sizes["grain"] == data["cfg"]["grains"]["n"]
+    scene, problem = _final(data)
+    f = np.column_stack([con.force_n.values, con.force_t.values])
+    H = h_matrix(scene, problem.contacts)
+    m = scene.mass[: scene.n_mobile]
+    gravity = np.column_stack([np.zeros_like(m), -9.81 * m, np.zeros_like(m)]).ravel()
+    imbalance = (H @ f.ravel() + gravity).reshape(-1, 3)
+    scale = np.column_stack([m * 9.81, m * 9.81, m * 9.81 * scene.radius[: scene.n_mobile]])
+    assert np.max(np.abs(imbalance) / scale) < 1e-5
+    assert np.all(f[:, 0] >= 0) and np.all(np.abs(f[:, 1]) <= problem.contacts.mu * f[:, 0] * (1 + 1e-9) + 1e-12)
+
+
+def test_ground_reaction_equals_the_weight(data):
+    cuts, ens = data["cuts"], data["ensemble"]
+    W = cuts.attrs["weight"]
+    assert cuts.attrs["history_ground_fy"] == pytest.approx(W, rel=WEIGHT_TOL)
+    assert abs(cuts.attrs["history_ground_fx"]) < WEIGHT_TOL * W
+    conv = ens.converged.values.astype(bool)
+    assert conv.sum() >= 0.9 * ens.sizes["run"], "most runs converge"
+    fy = ens.ground_fy.values[conv]
+    # momentum balance of the step: exact up to the solver residual
+    np.testing.assert_allclose(fy - W, ens.unbalanced_fy.values[conv], atol=MOMENTUM_TOL * W)
+    # the ground carries the weight, less the grains the zero-guess runs let move
+    assert np.max(np.abs(fy / W - 1)) < RUN_WEIGHT_TOL
+    np.testing.assert_allclose(ens.ground_pressure.values[conv] @ np.asarray(cuts.bin_hi - cuts.bin_lo), fy,
+                               rtol=1e-10)
+
+
+def test_every_run_records_the_solver(data):
+    for name in ("ensemble", "tolerance"):
+        ds = data[name]
+        conv = ds.converged.values.astype(bool)
+        tol = np.broadcast_to(ds.tol.values, conv.shape)
+        assert np.all(ds.residual.values[conv] <= tol[conv])
+        assert np.all(ds.sweeps.values[~conv] == ds.attrs["max_sweeps"])
+        assert np.all(ds.wall_time.values > 0)
+
+
+def test_members_do_not_depend_on_the_shard(data):
+    """The tolerance study repeats members 0..k-1 of the ensemble (other shard count)."""
+    ens, tol = data["ensemble"], data["tolerance"]
+    if float(ens.tol) not in tol.tol.values:
+        pytest.skip("the ensemble tolerance is not in the study")
+    t = tol.sel(tol=float(ens.tol))
+    e = ens.sel(run=t.run.values)
+    for k in ("cut_force_x", "cut_force_y", "ground_pressure", "sweeps", "residual", "converged"):
+        np.testing.assert_array_equal(t[k].values, e[k].values)
+
+
+def test_default_cut_resultant_is_parallel_to_the_surface(data):
+    cuts, ens = data["cuts"], data["ensemble"]
+    k = int(np.nonzero(cuts.kind.values == "default")[0][0])
+    assert cuts.n_crossing[k] >= 2
+    assert abs(float(cuts.history_deviation[k])) < MAX_DEVIATION_DEG
+    conv = ens.converged.values.astype(bool)
+    fx = ens.cut_force_x.values[conv, k].mean()
+    fy = ens.cut_force_y.values[conv, k].mean()
+    _, dev = cm.flank_angles(fx, fy, int(cuts.outer[k]), float(cuts.surface_angle[k]))
+    assert abs(dev) < MAX_DEVIATION_DEG
+
+
+def test_cloud_is_smaller_than_the_cut_sensitivity(data):
+    """Section 5: moving the cut by one diameter changes the resultant more than the
+    indetermination cloud spans."""
+    cuts, ens = data["cuts"], data["ensemble"]
+    kind = list(cuts.kind.values)
+    k, km, kp = kind.index("default"), kind.index("minus"), kind.index("plus")
+    conv = ens.converged.values.astype(bool)
+    P = np.column_stack([ens.cut_force_x.values[conv, k], ens.cut_force_y.values[conv, k]])
+    diameter = np.max(np.hypot(*(P[:, None] - P[None]).transpose(2, 0, 1)))
+    F = np.column_stack([cuts.history_fx.values, cuts.history_fy.values])
+    change = min(np.linalg.norm(F[km] - F[k]), np.linalg.norm(F[kp] - F[k]))
+    assert diameter < change, f"cloud diameter {diameter:.4g} N, cut change {change:.4g} N"

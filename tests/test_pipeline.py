@@ -1,0 +1,124 @@
+"""The Snakemake DAG: validation before any job, incremental reruns, shard invariance."""
+import os
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+import yaml
+
+from conftest import ROOT, copy_workflow, run_snakemake
+
+SCHEMAS = ROOT / "workflow" / "schemas"
+CONFIG = yaml.safe_load((ROOT / "config.yaml").read_text())
+FIGURES = [f for f in ("fig1_wedged", "fig2_slope", "fig3_equilibrium", "fig4_pile") if f in CONFIG]
+
+
+def planned_jobs(proc):
+    """Rule -> job count from the 'Job stats' table of a dry run."""
+    text = proc.stdout + proc.stderr
+    if "Nothing to be done" in text:
+        return {}
+    table = text.split("Job stats:", 1)[1]
+    jobs = {}
+    for line in table.splitlines()[3:]:
+        m = re.match(r"^(\S+)\s+(\d+)\s*$", line)
+        if not m:
+            break
+        if m.group(1) != "total":
+            jobs[m.group(1)] = int(m.group(2))
+    return jobs
+
+
+def first_bounded_key(schema, path=()):
+    """Path to the first property with a 'minimum' in a schema, and that minimum."""
+    for key, sub in schema.get("properties", {}).items():
+        if "minimum" in sub and sub.get("type") in ("number", "integer"):
+            return path + (key,), sub["minimum"]
+        found = first_bounded_key(sub, path + (key,))
+        if found:
+            return found
+    return None
+
+
+def nested(path, value):
+    out = value
+    for key in reversed(path):
+        out = {key: out}
+    return out
+
+
+def write_overlay(tmp_path, data):
+    p = tmp_path / "overlay.yaml"
+    p.write_text(yaml.safe_dump(data))
+    return p
+
+
+@pytest.fixture()
+def fresh_repo(tmp_path):
+    return copy_workflow(tmp_path / "repo")
+
+
+def test_unknown_section_stops_before_any_job(fresh_repo, tmp_path):
+    proc = run_snakemake(fresh_repo, "-n", extra_configs=[write_overlay(tmp_path, {"fig9_typo": {}})], check=False)
+    assert proc.returncode != 0
+    assert "fig9_typo" in proc.stdout + proc.stderr
+    assert not (fresh_repo / "results").exists()
+
+
+@pytest.mark.parametrize("figure", FIGURES)
+def test_misspelled_key_stops_before_any_job(fresh_repo, tmp_path, figure):
+    overlay = write_overlay(tmp_path, {figure: {"frobnication_typo": 1}})
+    proc = run_snakemake(fresh_repo, "-n", extra_configs=[overlay], check=False)
+    assert proc.returncode != 0
+    assert "frobnication_typo" in proc.stdout + proc.stderr
+    assert not (fresh_repo / "results").exists()
+
+
+@pytest.mark.parametrize("figure", FIGURES)
+def test_out_of_range_value_stops_naming_the_key(fresh_repo, tmp_path, figure):
+    schema = yaml.safe_load((SCHEMAS / f"{figure}.schema.yaml").read_text())
+    path, minimum = first_bounded_key(schema)
+    overlay = write_overlay(tmp_path, {figure: nested(path, minimum - 1)})
+    proc = run_snakemake(fresh_repo, "-n", extra_configs=[overlay], check=False)
+    out = proc.stdout + proc.stderr
+    assert proc.returncode != 0
+    assert path[-1] in out and "minimum" in out, out[-2000:]
+    assert not (fresh_repo / "results").exists()
+
+
+def test_second_run_does_nothing(dag_repo):
+    assert planned_jobs(run_snakemake(dag_repo, "-n")) == {}
+
+
+@pytest.mark.parametrize("figure", FIGURES)
+def test_touching_a_notebook_reruns_only_its_notebook(dag_repo, figure):
+    nb = dag_repo / "notebooks" / f"{figure}.ipynb"
+    st = nb.stat()
+    try:
+        os.utime(nb, (st.st_atime + 3600, st.st_mtime + 3600))
+        jobs = planned_jobs(run_snakemake(dag_repo, "-n"))
+    finally:
+        os.utime(nb, (st.st_atime, st.st_mtime))
+    assert set(jobs) == {f"{figure}_notebook", "render_html", "all"}, jobs
+
+
+@pytest.mark.parametrize("figure", FIGURES)
+def test_changing_a_scene_parameter_reruns_that_scene_only(dag_repo, tmp_path, figure):
+    schema = yaml.safe_load((SCHEMAS / f"{figure}.schema.yaml").read_text())
+    path, minimum = first_bounded_key(schema)
+    value = CONFIG[figure]
+    reduced = yaml.safe_load((ROOT / "tests" / "config_reduced.yaml").read_text()).get(figure, {})
+    for key in path:
+        value = value[key]
+    try:
+        for key in path:
+            reduced = reduced[key]
+        value = reduced
+    except (KeyError, TypeError):
+        pass
+    overlay = write_overlay(tmp_path, {figure: nested(path, value * 2 + 1)})
+    jobs = planned_jobs(run_snakemake(dag_repo, "-n", extra_configs=[overlay]))
+    assert jobs, "a parameter change must rerun something"
+    assert all(r.startswith(figure) or r in ("render_html", "all") for r in jobs), jobs

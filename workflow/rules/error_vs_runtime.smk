@@ -1,0 +1,57 @@
+# Work-precision diagrams (issue 5): NLGS at one step on states built here, and time
+# integration (incline, settled heap, slope flow), Contact Dynamics against MD.
+FIG = "error_vs_runtime"
+CFG = section(FIG)
+
+
+rule error_vs_runtime_nlgs:
+    """Build each state and run every NLGS setting on its next step."""
+    input:
+        NCD_SOURCES,
+    output:
+        "results/error_vs_runtime/nlgs.nc",
+    params:
+        config={k: CFG[k] for k in ("root_seed", "solver", "nlgs")},
+    log:
+        log(FIG, "error_vs_runtime_nlgs"),
+    benchmark:
+        bench(FIG, "error_vs_runtime_nlgs")
+    script:
+        "../scripts/error_vs_runtime_nlgs.py"
+
+
+rule error_vs_runtime_integration:
+    """CD over h and MD over h and stiffness, for each observable."""
+    input:
+        NCD_SOURCES,
+    output:
+        "results/error_vs_runtime/integration.nc",
+    params:
+        config={k: CFG[k] for k in ("root_seed", "solver", "integration")},
+    log:
+        log(FIG, "error_vs_runtime_integration"),
+    benchmark:
+        bench(FIG, "error_vs_runtime_integration")
+    script:
+        "../scripts/error_vs_runtime_integration.py"
+
+
+rule error_vs_runtime_notebook:
+    input:
+        nlgs="results/error_vs_runtime/nlgs.nc",
+        integration="results/error_vs_runtime/integration.nc",
+        notebook=str(ROOT / "notebooks" / "error_vs_runtime.ipynb"),
+    output:
+        png="results/figures/error_vs_runtime.png",
+        pdf="results/figures/error_vs_runtime.pdf",
+    log:
+        notebook="results/notebooks/error_vs_runtime.ipynb",
+    benchmark:
+        bench(FIG, "error_vs_runtime_notebook")
+    notebook:
+        "../../notebooks/error_vs_runtime.ipynb"
+
+
+rule error_vs_runtime:
+    input:
+        figure_targets(FIG),

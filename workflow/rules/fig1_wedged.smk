@@ -1,0 +1,95 @@
+# Figure 1 (Moreau 2005, section 1): the wedged disc.  See workflow/README.md.
+FIG = "fig1_wedged"
+CFG = section(FIG)
+
+
+rule fig1_wedged_explore:
+    """One shard of the one-step exploration ensemble (random and zero initial guesses)."""
+    input:
+        NCD_SOURCES,
+    output:
+        "results/fig1_wedged/shards/{name}_{shard}-of-{n}.nc",
+    wildcard_constraints:
+        name="ensemble",
+        shard=r"\d+",
+        n=r"\d+",
+    params:
+        config=CFG,
+    threads: 1
+    log:
+        log(FIG, "explore_{name}_{shard}-of-{n}"),
+    benchmark:
+        bench(FIG, "explore_{name}_{shard}-of-{n}")
+    script:
+        "../scripts/fig1_explore.py"
+
+
+rule fig1_wedged_merge:
+    input:
+        shard_files(FIG, "ensemble", CFG["ensemble"]["shards"]),
+    output:
+        "results/fig1_wedged/ensemble.nc",
+    params:
+        dim="run",
+    log:
+        log(FIG, "merge"),
+    benchmark:
+        bench(FIG, "merge")
+    script:
+        "../scripts/merge_shards.py"
+
+
+rule fig1_wedged_simulate:
+    """The two evolutions (zero guess at every step; wedged first guess then warm starts)."""
+    input:
+        NCD_SOURCES,
+    output:
+        "results/fig1_wedged/evolutions.nc",
+    params:
+        config=CFG,
+    threads: 1
+    log:
+        log(FIG, "simulate"),
+    benchmark:
+        bench(FIG, "simulate")
+    script:
+        "../scripts/fig1_simulate.py"
+
+
+rule fig1_wedged_sweep:
+    """Fraction of wedged outcomes against the friction angle."""
+    input:
+        NCD_SOURCES,
+    output:
+        "results/fig1_wedged/sweep.nc",
+    params:
+        config=CFG,
+    threads: 1
+    log:
+        log(FIG, "sweep"),
+    benchmark:
+        bench(FIG, "sweep")
+    script:
+        "../scripts/fig1_sweep.py"
+
+
+rule fig1_wedged_notebook:
+    input:
+        ensemble="results/fig1_wedged/ensemble.nc",
+        evolutions="results/fig1_wedged/evolutions.nc",
+        sweep="results/fig1_wedged/sweep.nc",
+        notebook=str(ROOT / "notebooks" / "fig1_wedged.ipynb"),
+    output:
+        png="results/figures/fig1_wedged.png",
+        pdf="results/figures/fig1_wedged.pdf",
+    log:
+        notebook="results/notebooks/fig1_wedged.ipynb",
+    benchmark:
+        bench(FIG, "notebook")
+    notebook:
+        "../../notebooks/fig1_wedged.ipynb"
+
+
+rule fig1_wedged:
+    input:
+        figure_targets(FIG),

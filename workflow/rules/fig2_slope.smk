@@ -1,0 +1,105 @@
+# Figure 2 of Moreau (2005), section 3: dispersion of a grain's acceleration in a
+# flow of discs down a 24° slope.
+#   simulate   deposit, release, flow with warm starts    -> trajectory.nc
+#   explore    zero-guess and warm-start NLGS runs of one
+#              block of members, tolerance by tolerance   -> shards/ensemble_<k>-of-<n>.nc
+#   merge      the shards, in member order                -> ensemble.nc
+#   analyse    spreads, principal axes, solutions, verdict -> measures.nc
+#   notebook   notebooks/fig2_slope.ipynb                  -> results/figures/fig2_slope.png|pdf
+FIG2 = "fig2_slope"
+CFG2 = section(FIG2)
+F2 = f"results/{FIG2}"
+# each rule sees only the sections it uses, so that e.g. an analysis
+# threshold does not rerun the simulation
+CFG2_SIM = {k: CFG2[k] for k in ("scene", "deposit", "flow", "scan")}
+CFG2_EXP = {k: CFG2[k] for k in ("scene", "flow", "explore")}
+
+
+rule fig2_slope_simulate:
+    input:
+        NCD_SOURCES,
+    output:
+        f"{F2}/trajectory.nc",
+    params:
+        config=CFG2_SIM,
+    log:
+        log(FIG2, "simulate"),
+    benchmark:
+        bench(FIG2, "simulate")
+    script:
+        "../scripts/fig2_slope_simulate.py"
+
+
+rule fig2_slope_explore:
+    input:
+        NCD_SOURCES,
+        trajectory=f"{F2}/trajectory.nc",
+    output:
+        f"{F2}/shards/ensemble_{{shard}}-of-{{n}}.nc",
+    wildcard_constraints:
+        shard=r"\d+",
+        n=r"\d+",
+    params:
+        config=CFG2_EXP,
+    log:
+        log(FIG2, "explore_{shard}-of-{n}"),
+    benchmark:
+        bench(FIG2, "explore_{shard}-of-{n}")
+    script:
+        "../scripts/fig2_slope_explore.py"
+
+
+rule fig2_slope_merge:
+    input:
+        shard_files(FIG2, "ensemble", CFG2["explore"]["shards"]),
+    output:
+        f"{F2}/ensemble.nc",
+    params:
+        dim="run",
+    log:
+        log(FIG2, "merge"),
+    benchmark:
+        bench(FIG2, "merge")
+    script:
+        "../scripts/merge_shards.py"
+
+
+rule fig2_slope_analyse:
+    input:
+        NCD_SOURCES,
+        trajectory=f"{F2}/trajectory.nc",
+        ensemble=f"{F2}/ensemble.nc",
+    output:
+        f"{F2}/measures.nc",
+    params:
+        config=CFG2,
+    log:
+        log(FIG2, "analyse"),
+    benchmark:
+        bench(FIG2, "analyse")
+    script:
+        "../scripts/fig2_slope_analyse.py"
+
+
+rule fig2_slope_notebook:
+    input:
+        trajectory=f"{F2}/trajectory.nc",
+        ensemble=f"{F2}/ensemble.nc",
+        measures=f"{F2}/measures.nc",
+        notebook=str(ROOT / "notebooks" / f"{FIG2}.ipynb"),
+    output:
+        png=f"results/figures/{FIG2}.png",
+        pdf=f"results/figures/{FIG2}.pdf",
+    params:
+        config=CFG2,
+    log:
+        notebook=f"results/notebooks/{FIG2}.ipynb",
+    benchmark:
+        bench(FIG2, "notebook")
+    notebook:
+        "../../notebooks/fig2_slope.ipynb"
+
+
+rule fig2_slope:
+    input:
+        figure_targets(FIG2),

@@ -1,0 +1,119 @@
+# Figure 3 of Moreau (2005), section 4: indetermination clouds of 28 discs at rest,
+# with the exact projections of A ∩ C and a uniform sample of it.
+#   simulate    packing deposited until at rest          -> state.nc
+#   explore     NLGS runs, one shard of one mode          -> shards/<mode>_<k>-of-<n>.nc
+#   merge       every shard of the three modes            -> ensemble.nc
+#   projection  LP projections of A ∩ C on each contact   -> projection.nc
+#   uniform     hit-and-run sample of A ∩ C               -> uniform.nc
+#   notebook    notebooks/fig3_equilibrium.ipynb           -> results/figures/fig3_equilibrium.png|pdf
+FIG = "fig3_equilibrium"
+CFG = section(FIG)
+F3 = f"results/{FIG}"
+F3_MODES = ("zero", "random", "warm")
+
+
+rule fig3_equilibrium_simulate:
+    input:
+        NCD_SOURCES,
+    output:
+        f"{F3}/state.nc",
+    params:
+        config=CFG,
+    log:
+        log(FIG, "simulate"),
+    benchmark:
+        bench(FIG, "simulate")
+    script:
+        "../scripts/fig3_equilibrium_simulate.py"
+
+
+rule fig3_equilibrium_explore:
+    input:
+        NCD_SOURCES,
+        state=f"{F3}/state.nc",
+    output:
+        f"{F3}/shards/{{name}}_{{shard}}-of-{{n}}.nc",
+    wildcard_constraints:
+        name="|".join(F3_MODES),
+        shard=r"\d+",
+        n=r"\d+",
+    params:
+        config=CFG,
+    log:
+        log(FIG, "explore_{name}_{shard}-of-{n}"),
+    benchmark:
+        bench(FIG, "explore_{name}_{shard}-of-{n}")
+    script:
+        "../scripts/fig3_equilibrium_explore.py"
+
+
+rule fig3_equilibrium_merge:
+    input:
+        [f for m in F3_MODES for f in shard_files(FIG, m, CFG["modes"][m]["shards"])],
+    output:
+        f"{F3}/ensemble.nc",
+    params:
+        dim="run",
+    log:
+        log(FIG, "merge"),
+    benchmark:
+        bench(FIG, "merge")
+    script:
+        "../scripts/merge_shards.py"
+
+
+rule fig3_equilibrium_projection:
+    input:
+        NCD_SOURCES,
+        state=f"{F3}/state.nc",
+    output:
+        f"{F3}/projection.nc",
+    params:
+        config=CFG,
+    log:
+        log(FIG, "projection"),
+    benchmark:
+        bench(FIG, "projection")
+    script:
+        "../scripts/fig3_equilibrium_projection.py"
+
+
+rule fig3_equilibrium_uniform:
+    input:
+        NCD_SOURCES,
+        state=f"{F3}/state.nc",
+    output:
+        f"{F3}/uniform.nc",
+    params:
+        config=CFG,
+    log:
+        log(FIG, "uniform"),
+    benchmark:
+        bench(FIG, "uniform")
+    script:
+        "../scripts/fig3_equilibrium_uniform.py"
+
+
+rule fig3_equilibrium_notebook:
+    input:
+        state=f"{F3}/state.nc",
+        ensemble=f"{F3}/ensemble.nc",
+        projection=f"{F3}/projection.nc",
+        uniform=f"{F3}/uniform.nc",
+        notebook=str(ROOT / "notebooks" / f"{FIG}.ipynb"),
+    output:
+        png=f"results/figures/{FIG}.png",
+        pdf=f"results/figures/{FIG}.pdf",
+    params:
+        config=CFG,
+    log:
+        notebook=f"results/notebooks/{FIG}.ipynb",
+    benchmark:
+        bench(FIG, "notebook")
+    notebook:
+        "../../notebooks/fig3_equilibrium.ipynb"
+
+
+rule fig3_equilibrium:
+    input:
+        figure_targets(FIG),

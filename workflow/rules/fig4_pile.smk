@@ -1,0 +1,111 @@
+# Figure 4 of Moreau (2005), section 5: a pile poured from a localized source; the
+# resultant across a vertical cut and its indetermination cloud.
+#   simulate   pour, settle until the warm equilibrium test passes -> construction.nc
+#   cuts       surface fit, cuts and ground pressure (history)     -> cuts.nc
+#   explore    zero-guess NLGS runs (random orders) of one shard of
+#              the ensemble or of the tolerance study               -> shards/<name>_<k>-of-<n>.nc
+#   merge      the shards, in member order                          -> ensemble.nc, tolerance.nc
+#   notebook   notebooks/fig4_pile.ipynb                            -> results/figures/fig4_pile.png|pdf
+FIG4 = "fig4_pile"
+CFG4 = section(FIG4)
+F4 = f"results/{FIG4}"
+# each rule sees only the sections it uses (a cut parameter does not rerun the construction)
+CFG4_SIM = {k: CFG4[k] for k in ("seed", "grains", "ground", "mu", "mu_ground", "gravity", "h", "source",
+                                 "construction")}
+CFG4_CUTS = {**CFG4_SIM, **{k: CFG4[k] for k in ("surface", "cut", "pressure")}}
+CFG4_EXP = {**CFG4_CUTS, **{k: CFG4[k] for k in ("ensemble", "tolerance_study")}}
+F4_SHARDS = {"ensemble": CFG4["ensemble"]["shards"], "tolerance": CFG4["tolerance_study"]["shards"]}
+
+
+rule fig4_pile_simulate:
+    input:
+        NCD_SOURCES,
+    output:
+        f"{F4}/construction.nc",
+    params:
+        config=CFG4_SIM,
+    log:
+        log(FIG4, "simulate"),
+    benchmark:
+        bench(FIG4, "simulate")
+    script:
+        "../scripts/fig4_pile_simulate.py"
+
+
+rule fig4_pile_cuts:
+    input:
+        NCD_SOURCES,
+        construction=f"{F4}/construction.nc",
+    output:
+        f"{F4}/cuts.nc",
+    params:
+        config=CFG4_CUTS,
+    log:
+        log(FIG4, "cuts"),
+    benchmark:
+        bench(FIG4, "cuts")
+    script:
+        "../scripts/fig4_pile_cuts.py"
+
+
+rule fig4_pile_explore:
+    input:
+        NCD_SOURCES,
+        construction=f"{F4}/construction.nc",
+        cuts=f"{F4}/cuts.nc",
+    output:
+        f"{F4}/shards/{{name}}_{{shard}}-of-{{n}}.nc",
+    wildcard_constraints:
+        name="ensemble|tolerance",
+        shard=r"\d+",
+        n=r"\d+",
+    params:
+        config=CFG4_EXP,
+    log:
+        log(FIG4, "explore_{name}_{shard}-of-{n}"),
+    benchmark:
+        bench(FIG4, "explore_{name}_{shard}-of-{n}")
+    script:
+        "../scripts/fig4_pile_explore.py"
+
+
+rule fig4_pile_merge:
+    input:
+        lambda w: shard_files(FIG4, w.name, F4_SHARDS[w.name]),
+    output:
+        f"{F4}/{{name}}.nc",
+    wildcard_constraints:
+        name="ensemble|tolerance",
+    params:
+        dim="run",
+    log:
+        log(FIG4, "merge_{name}"),
+    benchmark:
+        bench(FIG4, "merge_{name}")
+    script:
+        "../scripts/merge_shards.py"
+
+
+rule fig4_pile_notebook:
+    input:
+        construction=f"{F4}/construction.nc",
+        cuts=f"{F4}/cuts.nc",
+        ensemble=f"{F4}/ensemble.nc",
+        tolerance=f"{F4}/tolerance.nc",
+        notebook=str(ROOT / "notebooks" / f"{FIG4}.ipynb"),
+    output:
+        png=f"results/figures/{FIG4}.png",
+        pdf=f"results/figures/{FIG4}.pdf",
+    params:
+        config=CFG4,
+    log:
+        notebook=f"results/notebooks/{FIG4}.ipynb",
+    benchmark:
+        bench(FIG4, "notebook")
+    notebook:
+        "../../notebooks/fig4_pile.ipynb"
+
+
+rule fig4_pile:
+    input:
+        figure_targets(FIG4),

@@ -1,0 +1,14 @@
+"""Figure 2: spreads, principal axes, solutions and verdict of the ensembles (measures.nc)."""
+import xarray as xr
+
+from ncd.figures import slope_analysis
+from ncd.io import write_dataset
+from ncd.pipeline import start
+
+log = start(snakemake)  # noqa: F821 (snakemake is injected)
+traj = xr.load_dataset(snakemake.input.trajectory)  # noqa: F821
+ens = xr.load_dataset(snakemake.input.ensemble)  # noqa: F821
+ds = slope_analysis.measures_dataset(traj, ens, snakemake.params.config)  # noqa: F821
+write_dataset(ds, snakemake.output[0])  # noqa: F821
+log.info("grain %d, verdict: %s; %s", int(ds.attrs["grain"]), ds.attrs["verdict"],
+         ", ".join(f"{k} {ds.attrs[k]:.3g}" for k in ds.attrs if k.startswith("verdict_")))

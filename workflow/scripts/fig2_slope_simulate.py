@@ -1,0 +1,13 @@
+"""Figure 2: deposit, release and flow of the discs down the slope (trajectory.nc)."""
+from ncd.figures import slope
+from ncd.io import write_dataset
+from ncd.pipeline import Progress, start
+
+log = start(snakemake)  # noqa: F821 (snakemake is injected)
+cfg = snakemake.params.config  # noqa: F821
+ds = slope.trajectory_dataset(cfg, Progress(log, 0, "deposit and flow"))
+write_dataset(ds, snakemake.output[0])  # noqa: F821
+k = int(ds.attrs["investigated_step"]) - 1
+log.info("deposit: %d steps; flow: %d steps, %d not converged; investigated step %d at t = %.4f s: "
+         "%d contacts, mean vx %.4g m/s", ds.sizes["deposit_step"], ds.sizes["step"], int((ds.converged == 0).sum()),
+         k + 1, float(ds.attrs["investigated_time"]), int(ds.n_contacts[k]), float(ds.mean_vx[k]))

@@ -1,0 +1,20 @@
+"""Figure 4: one shard of zero-guess NLGS runs (random review orders) on the final pile."""
+import xarray as xr
+
+from ncd.explore import shard_members
+from ncd.figures import pile
+from ncd.io import write_dataset
+from ncd.pipeline import start
+
+log = start(snakemake)  # noqa: F821 (snakemake is injected)
+w = snakemake.wildcards  # noqa: F821
+cfg = snakemake.params.config  # noqa: F821
+e = cfg["ensemble"]
+study = cfg["tolerance_study"]
+runs, tols = (e["runs"], [e["tol"]]) if w.name == "ensemble" else (study["runs"], study["tolerances"])
+members = shard_members(runs, int(w.shard), int(w.n))
+ds = pile.ensemble_shard(cfg, xr.load_dataset(snakemake.input.construction),  # noqa: F821
+                         xr.load_dataset(snakemake.input.cuts), members, tols, e["root_seed"], log)  # noqa: F821
+if w.name == "ensemble":
+    ds = ds.isel(tol=0)
+write_dataset(ds, snakemake.output[0])  # noqa: F821

@@ -1,0 +1,16 @@
+"""Figure 4: pour the pile and settle it until the warm equilibrium test passes (construction.nc)."""
+from ncd.figures import pile
+from ncd.io import write_dataset
+from ncd.pipeline import start
+
+log = start(snakemake)  # noqa: F821 (snakemake is injected)
+cfg = snakemake.params.config  # noqa: F821
+scene, record, ground, eq = pile.construct(cfg, log)
+ds = pile.construction_dataset(cfg, scene, record, ground, eq)
+write_dataset(ds, snakemake.output[0])  # noqa: F821
+d = ds.attrs["mean_diameter"]
+log.info("%d grains, %d steps (t = %.3f s), %.1f ms/step, sweeps mean %.0f, %d steps not converged, "
+         "max interpenetration %.3f d; at rest: |u_f| = %.2g g h (%d sweeps)", ds.sizes["grain"], ds.sizes["step"],
+         float(ds.time[-1]), 1e3 * float(ds.wall_time.mean()), float(ds.sweeps.mean()),
+         int((~ds.converged.astype(bool)).sum()), float(ds.max_penetration.max()) / d,
+         ds.attrs["eq_max_velocity"], ds.attrs["eq_sweeps"])
