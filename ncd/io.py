@@ -53,6 +53,7 @@ def write_dataset(ds, path):
     os.close(fd)
     try:
         ds.to_netcdf(tmp, engine="netcdf4")
+        os.chmod(tmp, 0o644)  # mkstemp creates 0600 files
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
@@ -65,4 +66,6 @@ def merge_shards(paths, dim="run"):
     parts = [xr.load_dataset(p) for p in paths]
     ds = xr.concat(parts, dim=dim, data_vars="minimal", coords="minimal", compat="override",
                    combine_attrs="override")
+    for var in ds.variables.values():
+        var.encoding.pop("dtype", None)  # a string variable must not keep the first shard's width
     return ds.sortby(dim)
