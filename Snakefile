@@ -16,6 +16,10 @@ include: "workflow/rules/common.smk"
 for _figure in FIGURES:
     include: f"workflow/rules/{_figure}.smk"
 
+# the benchmark suite: `snakemake -j2 bench` (not part of the default target)
+if "bench" in config:
+    include: "workflow/rules/bench.smk"
+
 
 rule all:
     default_target: True

@@ -132,29 +132,6 @@ def local_velocity(body_a, body_b, normal, arm_a, arm_b, vel, spin, out):
     return out
 
 
-@njit(cache=True)
-def apply_impulses(body_a, body_b, normal, arm_a, arm_b, inv_mass, inv_inertia,
-                   impulse, vel, spin):
-    """``u += M^-1 H s``: add the effect of contact impulses to body velocities."""
-    for c in range(body_a.shape[0]):
-        apply_one(body_a[c], body_b[c], normal[c, 0], normal[c, 1], arm_a[c], arm_b[c],
-                  inv_mass, inv_inertia, impulse[c, 0], impulse[c, 1], vel, spin)
-
-
-@njit(cache=True, inline="always")
-def apply_one(a, b, nx, ny, ra, rb, inv_mass, inv_inertia, dn, dt, vel, spin):
-    """Add the impulse ``(dn, dt)`` of one contact to the velocities of a and b."""
-    px = dn * nx - dt * ny
-    py = dn * ny + dt * nx
-    vel[a, 0] += inv_mass[a] * px
-    vel[a, 1] += inv_mass[a] * py
-    spin[a] -= inv_inertia[a] * ra * dt
-    if b >= 0:
-        vel[b, 0] -= inv_mass[b] * px
-        vel[b, 1] -= inv_mass[b] * py
-        spin[b] -= inv_inertia[b] * rb * dt
-
-
 def match_warm(contacts, prev_keys, prev_impulse):
     """Previous impulses of persisting contacts (matched by body pair), zero elsewhere."""
     guess = np.zeros((contacts.n, 2))

@@ -5,9 +5,17 @@ from an initial guess (zero, warm, or drawn at random from a stated range) with
 a review order (fixed, or a random permutation).  Its randomness comes only
 from ``numpy.random.default_rng((member, root_seed))``, so a member gives the
 same result whatever shard or process runs it.
+
+The members of an ensemble run in parallel on ``threads`` threads (default:
+numba's thread count, which :func:`ncd.pipeline.start` sets from the rule's
+``threads``): the NLGS kernels release the GIL, every member runs serially on
+its own copies of the velocities and impulses, so the results are identical
+bit for bit whatever the thread count.
 """
 import time
+from concurrent.futures import ThreadPoolExecutor
 
+import numba
 import numpy as np
 
 from .nlgs import SolverSettings
@@ -37,13 +45,37 @@ def shard_members(n_members, shard, n_shards):
     return np.arange(bounds[shard], bounds[shard + 1])
 
 
+def run_parallel(task, n, threads=None, progress=None):
+    """Call ``task(k)`` for ``k`` in ``range(n)`` on ``threads`` threads (default:
+    ``numba.get_num_threads()``); ``progress(done, n)`` after each, in order.
+
+    ``task`` must write its own outputs (disjoint per ``k``) and spend its time in
+    GIL-free numba kernels; an exception in a task is raised here."""
+    threads = numba.get_num_threads() if threads is None else int(threads)
+    if threads < 1:
+        raise ValueError(f"threads = {threads} must be >= 1")
+    if threads == 1 or n <= 1:
+        results = map(task, range(n))
+        pool = None
+    else:
+        pool = ThreadPoolExecutor(max_workers=min(threads, n))
+        results = pool.map(task, range(n))
+    try:
+        for done, _ in enumerate(results, 1):
+            if progress is not None:
+                progress(done, n)
+    finally:
+        if pool is not None:
+            pool.shutdown(wait=True, cancel_futures=True)
+
+
 def explore(scene, problem, members, root_seed, init="zero", review="random", guess_scale=None,
-            settings=SolverSettings(), progress=None):
+            settings=SolverSettings(), progress=None, threads=None):
     """Run one NLGS per member on ``problem``; returns a dict of arrays stacked over members.
 
     ``init``: "zero", "warm" (the scene's previous impulses) or "random"
     (:func:`random_guess` with ``guess_scale``); ``review``: "fixed" or "random".
-    ``progress(done, total)`` is called now and then.
+    ``progress(done, total)`` is called now and then; ``threads``: see :func:`run_parallel`.
     """
     if init not in INIT_MODES:
         raise ValueError(f"init = {init!r} must be one of {INIT_MODES}")
@@ -65,8 +97,9 @@ def explore(scene, problem, members, root_seed, init="zero", review="random", gu
         "wall_time": np.zeros(len(members)),
     }
     warm = initial_guess(scene, problem, "warm") if init == "warm" else None
-    for k, member in enumerate(members):
-        rng = member_rng(member, root_seed)
+
+    def run(k):
+        rng = member_rng(members[k], root_seed)
         order = rng.permutation(n) if review == "random" else None
         guess = warm if init == "warm" else (
             random_guess(rng, problem.contacts.mu, guess_scale) if init == "random" else None)
@@ -80,6 +113,6 @@ def explore(scene, problem, members, root_seed, init="zero", review="random", gu
         out["residual"][k] = result.residual
         out["change"][k] = result.change
         out["converged"][k] = result.converged
-        if progress is not None:
-            progress(k + 1, len(members))
+
+    run_parallel(run, len(members), threads, progress)
     return out

@@ -58,14 +58,19 @@ def solve_single_contact(wnn, wnt, wtn, wtt, qn, qt, mu):
     rt = (wtn * qn - wnn * qt) / det
     if rn >= 0.0 and abs(rt) <= mu * rn:
         return rn, rt, STICK
-    for sigma in (1.0, -1.0):
-        denom = wnn - sigma * mu * wnt
-        if denom > 0.0:
-            sn = -qn / denom
-            st = -sigma * mu * sn
-            ut = wtn * sn + wtt * st + qt
-            if sigma * ut >= 0.0:
-                return sn, st, SLIDE_FORWARD if sigma > 0.0 else SLIDE_BACKWARD
+    # slide forward (sigma = +1: r_t = -mu r_n, U_t >= 0), then backward (sigma = -1)
+    denom = wnn - mu * wnt
+    if denom > 0.0:
+        sn = -qn / denom
+        st = -mu * sn
+        if wtn * sn + wtt * st + qt >= 0.0:
+            return sn, st, SLIDE_FORWARD
+    denom = wnn + mu * wnt
+    if denom > 0.0:
+        sn = -qn / denom
+        st = mu * sn
+        if wtn * sn + wtt * st + qt <= 0.0:
+            return sn, st, SLIDE_BACKWARD
     pn, pt = project_cone(rn, rt, mu)
     return pn, pt, FALLBACK
 

@@ -22,7 +22,7 @@ import numpy as np
 import scipy.sparse as sp
 from numba import njit
 
-from .contacts import apply_impulses, apply_one, delassus_blocks, local_velocity
+from .contacts import delassus_blocks, local_velocity
 from .local_solver import natural_map_sq, solve_single_contact
 
 CRITERIA = {"residual": 0, "change": 1}
@@ -88,35 +88,121 @@ def _done(res, change, tol, criterion):
 
 
 # ---------------------------------------------------------------- disc form
+# Data layout of the hot loop (one job: make a contact update a few cache-line
+# reads): ``body`` (n_disc + 1, 4) holds ``(v_x, v_y, omega, 0)`` per disc, the
+# last row a motionless dummy that stands for every wall; ``pair`` (n, 2) the
+# two body rows of a contact; ``coef`` (n, 16) everything else a contact update
+# reads, in the order of the ``C_*`` columns below.
+C_NX, C_NY, C_RA, C_RB, C_WNN, C_WNT, C_WTN, C_WTT, C_MU, C_BN, C_BT, C_IMA, C_IIA, C_IMB, C_IIB = range(15)
+N_COEF = 16
+
+
+@njit(cache=True, nogil=True)
+def pack_problem(body_a, body_b, normal, arm_a, arm_b, W, mu, bias, inv_mass, inv_inertia, vel, spin):
+    """Flat arrays ``(pair, coef, body)`` of the disc-form problem (layout above).
+
+    ``coef`` stores ``1/m`` and ``r/I`` per contact side (0 for a wall), so an
+    update needs no body property; the arithmetic is that of ``M^-1 H s``.
+    """
+    n = body_a.shape[0]
+    nd = vel.shape[0]
+    body = np.zeros((nd + 1, 4))
+    for i in range(nd):
+        body[i, 0] = vel[i, 0]
+        body[i, 1] = vel[i, 1]
+        body[i, 2] = spin[i]
+    pair = np.empty((n, 2), np.int64)
+    coef = np.zeros((n, N_COEF))
+    for c in range(n):
+        a = body_a[c]
+        b = body_b[c]
+        pair[c, 0] = a
+        pair[c, 1] = b if b >= 0 else nd
+        coef[c, C_NX] = normal[c, 0]
+        coef[c, C_NY] = normal[c, 1]
+        coef[c, C_RA] = arm_a[c]
+        coef[c, C_RB] = arm_b[c]
+        coef[c, C_WNN] = W[c, 0, 0]
+        coef[c, C_WNT] = W[c, 0, 1]
+        coef[c, C_WTN] = W[c, 1, 0]
+        coef[c, C_WTT] = W[c, 1, 1]
+        coef[c, C_MU] = mu[c]
+        coef[c, C_BN] = bias[c, 0]
+        coef[c, C_BT] = bias[c, 1]
+        coef[c, C_IMA] = inv_mass[a]
+        coef[c, C_IIA] = inv_inertia[a] * arm_a[c]
+        if b >= 0:
+            coef[c, C_IMB] = inv_mass[b]
+            coef[c, C_IIB] = inv_inertia[b] * arm_b[c]
+    return pair, coef, body
+
+
+# The kernels below take ``pair``, ``coef``, ``body`` and the impulses raveled
+# (1-D): rows at constant strides, which the compiler turns into fixed offsets.
+@njit(cache=True, inline="always")
+def _relative_velocity(pair, coef, body, c):
+    """``U = H_c^T u`` of contact ``c`` (normal, tangential), bias not included.
+
+    ``pair``, ``coef``, ``body`` are the flat (raveled) arrays: constant strides."""
+    a = 4 * pair[2 * c]
+    b = 4 * pair[2 * c + 1]
+    k = N_COEF * c
+    nx = coef[k + C_NX]
+    ny = coef[k + C_NY]
+    vx = body[a] - body[b]
+    vy = body[a + 1] - body[b + 1]
+    wt = coef[k + C_RA] * body[a + 2] + coef[k + C_RB] * body[b + 2]
+    return vx * nx + vy * ny, -vx * ny + vy * nx - wt
+
+
+@njit(cache=True, inline="always")
+def _add_impulse(pair, coef, body, c, dn, dt):
+    """``u += M^-1 H_c (dn, dt)``: the impulse increment of contact ``c`` on its two bodies."""
+    a = 4 * pair[2 * c]
+    b = 4 * pair[2 * c + 1]
+    k = N_COEF * c
+    nx = coef[k + C_NX]
+    ny = coef[k + C_NY]
+    px = dn * nx - dt * ny
+    py = dn * ny + dt * nx
+    body[a] += coef[k + C_IMA] * px
+    body[a + 1] += coef[k + C_IMA] * py
+    body[a + 2] -= coef[k + C_IIA] * dt
+    body[b] -= coef[k + C_IMB] * px
+    body[b + 1] -= coef[k + C_IMB] * py
+    body[b + 2] -= coef[k + C_IIB] * dt
+
+
+@njit(cache=True, nogil=True)
+def _apply_all(pair, coef, body, imp):
+    for c in range(imp.shape[0] // 2):
+        _add_impulse(pair, coef, body, c, imp[2 * c], imp[2 * c + 1])
+
+
 @njit(cache=True)
 def _sweep_discs(data, order, status):
-    body_a, body_b, normal, arm_a, arm_b, W, mu, bias, inv_mass, inv_inertia, vel, spin, imp = data
+    pair, coef, body, imp = data
     dsum = 0.0
     ssum = 0.0
     for k in range(order.shape[0]):
         c = order[k]
-        a = body_a[c]
-        b = body_b[c]
-        nx = normal[c, 0]
-        ny = normal[c, 1]
-        vx = vel[a, 0]
-        vy = vel[a, 1]
-        wt = arm_a[c] * spin[a]
-        if b >= 0:
-            vx -= vel[b, 0]
-            vy -= vel[b, 1]
-            wt += arm_b[c] * spin[b]
-        sn = imp[c, 0]
-        st = imp[c, 1]
-        qn = vx * nx + vy * ny - W[c, 0, 0] * sn - W[c, 0, 1] * st + bias[c, 0]
-        qt = -vx * ny + vy * nx - wt - W[c, 1, 0] * sn - W[c, 1, 1] * st + bias[c, 1]
-        rn, rt, st_ = solve_single_contact(W[c, 0, 0], W[c, 0, 1], W[c, 1, 0], W[c, 1, 1], qn, qt, mu[c])
+        un, ut = _relative_velocity(pair, coef, body, c)
+        j = N_COEF * c
+        wnn = coef[j + C_WNN]
+        wnt = coef[j + C_WNT]
+        wtn = coef[j + C_WTN]
+        wtt = coef[j + C_WTT]
+        sn = imp[2 * c]
+        st = imp[2 * c + 1]
+        qn = un - wnn * sn - wnt * st + coef[j + C_BN]
+        qt = ut - wtn * sn - wtt * st + coef[j + C_BT]
+        rn, rt, st_ = solve_single_contact(wnn, wnt, wtn, wtt, qn, qt, coef[j + C_MU])
         status[c] = st_
         dn = rn - sn
         dt = rt - st
-        imp[c, 0] = rn
-        imp[c, 1] = rt
-        apply_one(a, b, nx, ny, arm_a[c], arm_b[c], inv_mass, inv_inertia, dn, dt, vel, spin)
+        imp[2 * c] = rn
+        imp[2 * c + 1] = rt
+        _add_impulse(pair, coef, body, c, dn, dt)
         dsum += abs(dn) + abs(dt)
         ssum += abs(rn) + abs(rt)
     return dsum, ssum
@@ -124,18 +210,19 @@ def _sweep_discs(data, order, status):
 
 @njit(cache=True)
 def _residual_discs(data):
-    body_a, body_b, normal, arm_a, arm_b, W, mu, bias, inv_mass, inv_inertia, vel, spin, imp = data
-    U = local_velocity(body_a, body_b, normal, arm_a, arm_b, vel, spin, np.empty((body_a.shape[0], 2)))
+    pair, coef, body, imp = data
     rsq = 0.0
     ssq = 0.0
-    for c in range(body_a.shape[0]):
-        rsq += natural_map_sq(imp[c, 0], imp[c, 1], U[c, 0] + bias[c, 0], U[c, 1] + bias[c, 1],
-                              mu[c], 1.0 / W[c, 0, 0])
-        ssq += imp[c, 0] ** 2 + imp[c, 1] ** 2
+    for c in range(imp.shape[0] // 2):
+        un, ut = _relative_velocity(pair, coef, body, c)
+        j = N_COEF * c
+        rsq += natural_map_sq(imp[2 * c], imp[2 * c + 1], un + coef[j + C_BN], ut + coef[j + C_BT],
+                              coef[j + C_MU], 1.0 / coef[j + C_WNN])
+        ssq += imp[2 * c] ** 2 + imp[2 * c + 1] ** 2
     return rsq, ssq
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _iterate_discs(data, order, status, scale, tol, max_sweeps, criterion, check_every):
     """The NLGS driver (disc form): sweeps until the criterion holds or ``max_sweeps``."""
     change = np.inf
@@ -187,13 +274,15 @@ def solve_discs(scene, contacts, vel, spin, guess=None, review_order=None,
     c = contacts
     W = delassus_blocks(c.body_a, c.body_b, c.arm_a, c.arm_b, scene.inv_mass, scene.inv_inertia) if W is None else W
     q_free = local_velocity(c.body_a, c.body_b, c.normal, c.arm_a, c.arm_b, vel, spin, np.empty((n, 2))) + bias
-    apply_impulses(c.body_a, c.body_b, c.normal, c.arm_a, c.arm_b, scene.inv_mass, scene.inv_inertia,
-                   impulse, vel, spin)
-    data = (c.body_a, c.body_b, c.normal, c.arm_a, c.arm_b, W, c.mu, bias,
-            scene.inv_mass, scene.inv_inertia, vel, spin, impulse)
-    sweeps, res, change, ok = _iterate_discs(data, order, status, _scale(q_free, W), settings.tol,
-                                             settings.max_sweeps, CRITERIA[settings.criterion],
-                                             settings.check_every)
+    pair, coef, body = pack_problem(c.body_a, c.body_b, c.normal, c.arm_a, c.arm_b, W, c.mu, bias,
+                                    scene.inv_mass, scene.inv_inertia, vel, spin)
+    flat = (pair.ravel(), coef.ravel(), body.ravel(), impulse.ravel())
+    _apply_all(*flat)
+    sweeps, res, change, ok = _iterate_discs(flat, order, status,
+                                             _scale(q_free, W), settings.tol, settings.max_sweeps,
+                                             CRITERIA[settings.criterion], settings.check_every)
+    vel[:] = body[:-1, :2]
+    spin[:] = body[:-1, 2]
     return NLGSResult(impulse, status, int(sweeps), float(res), float(change), bool(ok))
 
 
@@ -239,7 +328,7 @@ def _residual_local(data):
     return rsq, ssq
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _iterate_local(data, order, status, scale, tol, max_sweeps, criterion, check_every):
     """The NLGS driver (local form): sweeps until the criterion holds or ``max_sweeps``."""
     change = np.inf

@@ -47,9 +47,10 @@ def run_snakemake(repo, *args, extra_configs=(), check=True, workdir=None):
 
 @pytest.fixture(scope="session")
 def dag_repo(tmp_path_factory):
-    """A copy of the workflow in which the reduced DAG has run completely."""
+    """A copy of the workflow in which the reduced DAG (every figure and the benchmark
+    suite) has run completely."""
     repo = copy_workflow(tmp_path_factory.mktemp("repo"))
-    run_snakemake(repo, "-j2")
+    run_snakemake(repo, "-j2", "all", "bench")
     return repo
 
 

@@ -128,3 +128,48 @@ def test_changing_a_scene_parameter_reruns_that_scene_only(dag_repo, tmp_path, f
     jobs = planned_jobs(run_snakemake(dag_repo, "-n", extra_configs=[overlay]))
     assert jobs, "a parameter change must rerun something"
     assert all(r.startswith(figure) or r in ("render_html", "all") for r in jobs), jobs
+
+
+def test_an_ensemble_does_not_depend_on_shards_or_jobs(dag_repo, tmp_path):
+    """fig1's merged ensemble rebuilt elsewhere with 3 shards at -j1 holds the same
+    numbers as the DAG's (2 shards, -j2); only the measured wall times may differ."""
+    overlay = write_overlay(tmp_path, {"fig1_wedged": {"ensemble": {"shards": 3}}})
+    work = tmp_path / "work"
+    run_snakemake(dag_repo, "-j1", "results/fig1_wedged/ensemble.nc", extra_configs=[overlay], workdir=work)
+    ref = xr.load_dataset(dag_repo / "results" / "fig1_wedged" / "ensemble.nc")
+    new = xr.load_dataset(work / "results" / "fig1_wedged" / "ensemble.nc")
+    assert len(list((work / "results" / "fig1_wedged" / "shards").glob("ensemble_*-of-3.nc"))) == 3
+    timing = [v for v in ref.data_vars if "wall_time" in v]
+    xr.testing.assert_identical(ref.drop_vars(timing).drop_attrs(), new.drop_vars(timing).drop_attrs())
+
+
+def test_every_ncd_module_is_a_source_of_the_figures_that_import_it():
+    """NCD_MODULES (common.smk) lists, per figure, the modules outside the core its
+    rules depend on; a module imported by a listed one must be listed too, and every
+    module of ncd/figures and ncd/studies belongs to some figure."""
+    import ast
+    text = (ROOT / "workflow" / "rules" / "common.smk").read_text()
+    modules = ast.literal_eval(re.search(r"NCD_MODULES = (\{.*?\n\})", text, re.S).group(1))
+    listed = set()
+    for figure, files in modules.items():
+        listed.update(files)
+        for f in files:
+            if not f.endswith(".py"):
+                continue
+            tree = ast.parse((ROOT / "ncd" / f).read_text())
+            pkg = f.split("/")[0]
+            for node in ast.walk(tree):
+                if isinstance(node, ast.ImportFrom):
+                    mod = node.module or ""
+                    if node.level == 1:            # from . import x / from .x import y
+                        names = [mod] if mod else [a.name for a in node.names]
+                        deps = [f"{pkg}/{n}.py" for n in names]
+                    elif mod.startswith("ncd.figures.") or mod.startswith("ncd.studies."):
+                        deps = [mod[4:].replace(".", "/") + ".py"]
+                    else:
+                        continue
+                    for d in deps:
+                        assert d in files, f"{figure}: {f} imports {d}, not in NCD_MODULES[{figure!r}]"
+    own = {str(p.relative_to(ROOT / "ncd")) for d in ("figures", "studies") for p in (ROOT / "ncd" / d).iterdir()
+           if p.suffix in (".py", ".c")}
+    assert own == listed, own ^ listed

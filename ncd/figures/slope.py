@@ -24,7 +24,7 @@ import time
 import numpy as np
 import xarray as xr
 
-from ..explore import explore, member_rng
+from ..explore import explore, member_rng, run_parallel
 from ..io import provenance
 from ..nlgs import SolverSettings
 from ..scene import make_scene
@@ -303,15 +303,19 @@ def run_ensemble(traj, cfg, members, progress=None):
     status = np.zeros((len(INITS), nr, nc), np.int8)
     total = len(INITS) * nr
     for i, init in enumerate(INITS):
-        for r, member in enumerate(members):
-            out = run_member(scene, problem, member, ecfg["root_seed"], init, tolerances, ecfg)
+        def task(r, i=i, init=init):
+            out = run_member(scene, problem, members[r], ecfg["root_seed"], init, tolerances, ecfg)
             acc[i, :, r] = out["accel"]
             for k in diag:
                 diag[k][i, :, r] = out[k]
             imp[i, r], status[i, r], spin_acc[i, r] = out["impulse"], out["status"], out["spin_accel"]
+
+        def report(done, n, i=i, init=init):
             if progress is not None:
-                progress(i * nr + r + 1, total, f"{init} run {member}: sweeps {out['sweeps'][-1]}, "
-                                                 f"residual {out['residual'][-1]:.2e}")
+                progress(i * nr + done, total, f"{init} runs done {done}/{n}: sweeps "
+                                               f"{diag['sweeps'][i, -1, done - 1]}, residual "
+                                               f"{diag['residual'][i, -1, done - 1]:.2e}")
+        run_parallel(task, nr, progress=report)
     c = problem.contacts
     warm = initial_guess(scene, problem, "warm")
     ds = xr.Dataset(

@@ -20,8 +20,29 @@ FIGURES = [f for f in ("fig1_wedged", "fig2_slope", "fig3_equilibrium", "fig4_pi
                        "stability", "error_vs_runtime")
            if (ROOT / "workflow" / "rules" / f"{f}.smk").exists() and f in config]
 
-# Every source file of the solver: a change in ncd/ reruns simulations and explorations.
-NCD_SOURCES = sorted(str(p) for p in (ROOT / "ncd").rglob("*.py"))
+# Threads of an ensemble rule: its NLGS runs are spread over them (ncd.explore.run_parallel,
+# results identical whatever the count); Snakemake lowers it to the cores it was given.
+ENSEMBLE_THREADS = 2
+
+# The sources a figure's simulation and exploration rules depend on: the solver core
+# (every module at the top of ncd/) and the figure's own modules, so that editing the
+# core reruns every figure and editing a figure's module reruns that figure only.
+NCD_CORE = sorted(str(p) for p in (ROOT / "ncd").glob("*.py"))
+NCD_MODULES = {
+    "fig1_wedged": ["figures/__init__.py", "figures/wedged.py"],
+    "fig2_slope": ["figures/__init__.py", "figures/slope.py", "figures/slope_analysis.py"],
+    "fig3_equilibrium": ["figures/__init__.py", "figures/equilibrium.py"],
+    "fig4_pile": ["figures/__init__.py", "figures/pile.py", "figures/cuts.py"],
+    "stability": ["studies/__init__.py", "studies/stability.py", "studies/scenes.py"],
+    "error_vs_runtime": ["studies/__init__.py", "studies/work_precision.py", "studies/scenes.py"],
+    "bench": ["studies/__init__.py", "studies/bench.py", "studies/peer.py", "studies/c_sweep.c",
+              "figures/__init__.py", "figures/pile.py", "figures/cuts.py"],
+}
+
+
+def ncd_sources(figure):
+    """Input files of a figure's computing rules: the solver core and the figure's modules."""
+    return NCD_CORE + [str(ROOT / "ncd" / m) for m in NCD_MODULES[figure]]
 
 
 def section(figure):

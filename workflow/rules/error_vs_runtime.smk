@@ -7,7 +7,7 @@ CFG = section(FIG)
 rule error_vs_runtime_nlgs:
     """Build each state and run every NLGS setting on its next step."""
     input:
-        NCD_SOURCES,
+        ncd_sources(FIG),
     output:
         "results/error_vs_runtime/nlgs.nc",
     params:
@@ -23,7 +23,7 @@ rule error_vs_runtime_nlgs:
 rule error_vs_runtime_integration:
     """CD over h and MD over h and stiffness, for each observable."""
     input:
-        NCD_SOURCES,
+        ncd_sources(FIG),
     output:
         "results/error_vs_runtime/integration.nc",
     params:

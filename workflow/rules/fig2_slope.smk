@@ -17,7 +17,7 @@ CFG2_EXP = {k: CFG2[k] for k in ("scene", "flow", "explore")}
 
 rule fig2_slope_simulate:
     input:
-        NCD_SOURCES,
+        ncd_sources(FIG2),
     output:
         f"{F2}/trajectory.nc",
     params:
@@ -32,13 +32,14 @@ rule fig2_slope_simulate:
 
 rule fig2_slope_explore:
     input:
-        NCD_SOURCES,
+        ncd_sources(FIG2),
         trajectory=f"{F2}/trajectory.nc",
     output:
         f"{F2}/shards/ensemble_{{shard}}-of-{{n}}.nc",
     wildcard_constraints:
         shard=r"\d+",
         n=r"\d+",
+    threads: ENSEMBLE_THREADS
     params:
         config=CFG2_EXP,
     log:
@@ -66,7 +67,7 @@ rule fig2_slope_merge:
 
 rule fig2_slope_analyse:
     input:
-        NCD_SOURCES,
+        ncd_sources(FIG2),
         trajectory=f"{F2}/trajectory.nc",
         ensemble=f"{F2}/ensemble.nc",
     output:

@@ -14,7 +14,7 @@ F3_MODES = ("zero", "random", "warm")
 
 rule fig3_equilibrium_simulate:
     input:
-        NCD_SOURCES,
+        ncd_sources(FIG),
     output:
         f"{F3}/state.nc",
     params:
@@ -29,7 +29,7 @@ rule fig3_equilibrium_simulate:
 
 rule fig3_equilibrium_explore:
     input:
-        NCD_SOURCES,
+        ncd_sources(FIG),
         state=f"{F3}/state.nc",
     output:
         f"{F3}/shards/{{name}}_{{shard}}-of-{{n}}.nc",
@@ -37,6 +37,7 @@ rule fig3_equilibrium_explore:
         name="|".join(F3_MODES),
         shard=r"\d+",
         n=r"\d+",
+    threads: ENSEMBLE_THREADS
     params:
         config=CFG,
     log:
@@ -64,7 +65,7 @@ rule fig3_equilibrium_merge:
 
 rule fig3_equilibrium_projection:
     input:
-        NCD_SOURCES,
+        ncd_sources(FIG),
         state=f"{F3}/state.nc",
     output:
         f"{F3}/projection.nc",
@@ -80,7 +81,7 @@ rule fig3_equilibrium_projection:
 
 rule fig3_equilibrium_uniform:
     input:
-        NCD_SOURCES,
+        ncd_sources(FIG),
         state=f"{F3}/state.nc",
     output:
         f"{F3}/uniform.nc",

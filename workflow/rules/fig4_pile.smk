@@ -19,7 +19,7 @@ F4_SHARDS = {"ensemble": CFG4["ensemble"]["shards"], "tolerance": CFG4["toleranc
 
 rule fig4_pile_simulate:
     input:
-        NCD_SOURCES,
+        ncd_sources(FIG4),
     output:
         f"{F4}/construction.nc",
     params:
@@ -34,7 +34,7 @@ rule fig4_pile_simulate:
 
 rule fig4_pile_cuts:
     input:
-        NCD_SOURCES,
+        ncd_sources(FIG4),
         construction=f"{F4}/construction.nc",
     output:
         f"{F4}/cuts.nc",
@@ -50,7 +50,7 @@ rule fig4_pile_cuts:
 
 rule fig4_pile_explore:
     input:
-        NCD_SOURCES,
+        ncd_sources(FIG4),
         construction=f"{F4}/construction.nc",
         cuts=f"{F4}/cuts.nc",
     output:
@@ -59,6 +59,7 @@ rule fig4_pile_explore:
         name="ensemble|tolerance",
         shard=r"\d+",
         n=r"\d+",
+    threads: ENSEMBLE_THREADS
     params:
         config=CFG4_EXP,
     log:

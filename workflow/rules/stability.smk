@@ -7,7 +7,7 @@ CFG = section(FIG)
 rule stability_simulate:
     """The stability table: one row per (case, method, h)."""
     input:
-        NCD_SOURCES,
+        ncd_sources(FIG),
     output:
         "results/stability/table.nc",
     params:

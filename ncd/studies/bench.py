@@ -1,0 +1,326 @@
+"""Benchmarks of the solver (issues 2 and 6): measurements, not tests.
+
+* :func:`core_table`: on dense packings of 10^3 to 10^5 discs, the cost of one
+  NLGS contact update (ns) of the numba sweep and of the same loop in plain C
+  (``c_sweep.c``, gcc -O3, on the same packed arrays: the hardware reference),
+  contact detection, step preparation, the time per Moreau-Jean step and the
+  peak memory of building and stepping the scene;
+* :func:`sweeps_table`: the sweeps NLGS needs to reach a fixed tolerance
+  as N grows, from the zero guess and from the warm start;
+* :func:`ensemble_table`: an ensemble of NLGS runs on 1 and on 2 threads
+  (:func:`ncd.explore.run_parallel`): speed-up and bit-for-bit equality;
+* :func:`startup`: ``import ncd`` and a first step in a fresh interpreter
+  with a warm numba cache;
+* :func:`rule_times`: the wall time and memory of every pipeline rule, read
+  from Snakemake's ``benchmark:`` files.
+
+The packing is a triangular lattice of spacing ``s`` (rows alternately shifted
+by ``s/2``, positions jittered by ``1e-3 s``) in a box (floor and two side
+walls) under gravity, radii ``s/2 (1.005 + 0.02 u)``, ``u`` uniform in [0, 1]:
+every lattice neighbour pair overlaps by 0.5 % to 4.5 % of ``s/2``, about three
+contacts per disc, as in a jammed packing.
+"""
+import hashlib
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from .. import nlgs
+from ..contacts import detect_contacts
+from ..explore import explore
+from ..nlgs import SolverSettings
+from ..scene import make_scene
+from ..stepper import initial_guess, prepare_step, solve_problem, step
+
+C_SOURCE = Path(__file__).with_name("c_sweep.c")
+H = 1e-3
+
+
+def dense_packing(n, seed=0, s=1.0):
+    """About ``n`` discs on a jittered triangular lattice, neighbours slightly overlapping."""
+    rng = np.random.default_rng((0, seed))
+    ny = max(2, int(round(np.sqrt(n * np.sqrt(3) / 2))))
+    nx = int(np.ceil(n / ny))
+    k, j = np.divmod(np.arange(nx * ny), nx)
+    x = s / 2 + j * s + (k % 2) * s / 2
+    y = s / 2 + k * s * np.sqrt(3) / 2
+    pos = np.column_stack([x, y]) + rng.uniform(-1e-3, 1e-3, (nx * ny, 2)) * s
+    radius = s / 2 * (1.005 + 0.02 * rng.random(nx * ny))
+    width = nx * s + s / 2
+    walls = [((0.0, 0.0), (0.0, 1.0)), ((0.0, 0.0), (1.0, 0.0)), ((width, 0.0), (-1.0, 0.0))]
+    return make_scene(pos, radius, 1.0, walls=walls, mu=0.5, overlap_tolerance=0.06)
+
+
+def best_of(fn, repeat):
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return min(times)
+
+
+def fixed_sweeps(sweeps):
+    """Settings that run exactly ``sweeps`` sweeps (residual evaluated once, at the end)."""
+    return SolverSettings(tol=1e-300, max_sweeps=sweeps, check_every=sweeps)
+
+
+def _status_bytes(field):
+    for line in Path("/proc/self/status").read_text().splitlines():
+        if line.startswith(field + ":"):
+            return float(line.split()[1]) * 1024.0
+    return np.nan
+
+
+class PeakMemory:
+    """Peak resident memory (bytes) of the process inside a ``with`` block, and its
+    growth over the resident memory at entry (Linux: ``/proc/self/clear_refs``
+    resets ``VmHWM``); NaN where that is not available."""
+
+    def __enter__(self):
+        try:
+            Path("/proc/self/clear_refs").write_text("5")
+            self.start = _status_bytes("VmRSS")
+        except OSError:
+            self.start = None
+        return self
+
+    def __exit__(self, *exc):
+        self.peak = self.growth = np.nan
+        if self.start is not None:
+            self.peak = _status_bytes("VmHWM")
+            self.growth = self.peak - self.start
+        return False
+
+
+def packed_problem(scene, problem):
+    """The flat arrays of the NLGS kernel (:func:`ncd.nlgs.pack_problem`) of a prepared step."""
+    c = problem.contacts
+    pair, coef, body = nlgs.pack_problem(c.body_a, c.body_b, c.normal, c.arm_a, c.arm_b, problem.W,
+                                         c.mu, problem.bias, scene.inv_mass, scene.inv_inertia,
+                                         problem.free_vel, problem.free_spin)
+    return pair.ravel(), coef.ravel(), body.ravel()
+
+
+def nlgs_sweep_cost(scene, problem, sweeps, repeat):
+    """Seconds per sweep of the numba kernel (best of ``repeat`` runs of ``sweeps``
+    sweeps from the zero guess, identity review order) and the final impulses."""
+    pair, coef, body = packed_problem(scene, problem)
+    n = problem.contacts.n
+    order = np.arange(n)
+    status = np.zeros(n, np.int8)
+    best, imp = np.inf, None
+    for _ in range(repeat):
+        b, imp = body.copy(), np.zeros(2 * n)
+        t0 = time.perf_counter()
+        for _ in range(sweeps):
+            nlgs._sweep_discs((pair, coef, b, imp), order, status)
+        best = min(best, time.perf_counter() - t0)
+    return best / sweeps, imp
+
+
+def c_sweep_cost(scene, problem, sweeps, workdir):
+    """Seconds per sweep of ``c_sweep.c`` (gcc -O3 -march=native) on the same packed
+    arrays and the sum of its final impulses; ``(nan, nan)`` without a C compiler."""
+    cc = shutil.which("gcc") or shutil.which("cc")
+    if cc is None:
+        return np.nan, np.nan
+    exe = Path(workdir) / "c_sweep"
+    if not exe.exists():
+        subprocess.run([cc, "-O3", "-march=native", "-o", str(exe), str(C_SOURCE), "-lm"], check=True)
+    pair, coef, body = packed_problem(scene, problem)
+    n = problem.contacts.n
+    data = Path(workdir) / "problem.bin"
+    with open(data, "wb") as f:
+        np.array([n, len(body) // 4, sweeps], np.int64).tofile(f)
+        np.arange(n, dtype=np.int64).tofile(f)
+        for a in (pair, coef, body, np.zeros(2 * n)):
+            a.tofile(f)
+    out = subprocess.run([str(exe), str(data)], check=True, capture_output=True, text=True).stdout.split()
+    return float(out[0]), float(out[1])
+
+
+def core_row(n, cfg, workdir):
+    """One size of :func:`core_table`."""
+    with PeakMemory() as mem:
+        scene = dense_packing(n)
+        problem = prepare_step(scene, H)
+        settings = SolverSettings(tol=cfg["step_tol"], max_sweeps=cfg["step_sweeps"], check_every=10)
+        step(scene, H, settings=settings)
+    repeat = 3 if n <= 10_000 else 2
+    gap = 1e-9 * scene.radius.min()
+    sweeps = cfg["sweeps"]
+    t_sweep, imp = nlgs_sweep_cost(scene, problem, sweeps, repeat)
+    t_c, c_sum = c_sweep_cost(scene, problem, sweeps, workdir)
+    reports, times = [], []
+    for _ in range(cfg["steps"]):
+        t0 = time.perf_counter()
+        reports.append(step(scene, H, settings=settings))
+        times.append(time.perf_counter() - t0)
+    nc = problem.contacts.n
+    return {
+        "n_discs": scene.n_mobile, "n_contacts": nc,
+        "ns_per_update": 1e9 * t_sweep / nc, "ns_per_update_c": 1e9 * t_c / nc,
+        # the C loop performs the same floating-point operations in the same order
+        "c_agrees": float(abs(c_sum - imp.sum()) <= 1e-9 * max(1.0, np.abs(imp).sum())),
+        "detect_s": best_of(lambda: detect_contacts(scene, alert=gap), repeat),
+        "prepare_s": best_of(lambda: prepare_step(scene, H), repeat),
+        "step_s": float(np.mean(times)),
+        "step_sweeps": float(np.mean([r.sweeps for r in reports])),
+        "step_converged": float(np.mean([r.converged for r in reports])),
+        "peak_memory": mem.peak, "memory_growth": mem.growth,
+    }
+
+
+UNITS = {"ns_per_update": ("ns", "numba NLGS sweep: time per contact update"),
+         "ns_per_update_c": ("ns", "the same sweep in C (gcc -O3 -march=native): time per contact update"),
+         "c_agrees": ("1", "1 if the C and numba sweeps give the same impulses"),
+         "detect_s": ("s", "contact detection"), "prepare_s": ("s", "step preparation (with detection)"),
+         "step_s": ("s", "Moreau-Jean step, warm start"), "step_sweeps": ("1", "mean NLGS sweeps per step"),
+         "step_converged": ("1", "fraction of steps converged within the sweep budget"),
+         "peak_memory": ("B", "peak resident memory of the process while building the packing and making one step"),
+         "memory_growth": ("B", "peak resident memory above the process's resident memory before the build")}
+
+
+def core_table(cfg, log=None):
+    """Per size of ``cfg["sizes"]``: the quantities of :data:`UNITS` (module docstring)."""
+    rows = []
+    core_row(200, cfg, tempfile.mkdtemp())      # compile / load every kernel first
+    with tempfile.TemporaryDirectory() as workdir:
+        for n in cfg["sizes"]:
+            rows.append(core_row(n, cfg, workdir))
+            if log is not None:
+                log.info("N = %d: %.1f ns/update (C %.1f), step %.3g s", rows[-1]["n_discs"],
+                         rows[-1]["ns_per_update"], rows[-1]["ns_per_update_c"], rows[-1]["step_s"])
+    ds = xr.Dataset({k: ("size", np.array([r[k] for r in rows])) for k in rows[0]},
+                    coords={"size": np.asarray(cfg["sizes"])})
+    for k, (units, name) in UNITS.items():
+        ds[k].attrs.update(units=units, long_name=name)
+    return ds
+
+
+def sweeps_table(cfg, log=None):
+    """Sweeps to reach ``cfg["tol"]`` (natural-map residual) on one step of each
+    packing of ``cfg["sizes"]``: from the zero guess, and warm-started after
+    ``cfg["warm_steps"]`` steps; runs that exhaust ``cfg["max_sweeps"]`` are flagged."""
+    settings = SolverSettings(tol=cfg["tol"], max_sweeps=cfg["max_sweeps"], check_every=10)
+    data = {f"{k}_{init}": [] for k in ("sweeps", "residual", "converged", "wall_time")
+            for init in ("zero", "warm")}
+    for n in cfg["sizes"]:
+        scene = dense_packing(n)
+        for init in ("zero", "warm"):
+            if init == "warm":
+                for _ in range(cfg["warm_steps"]):
+                    step(scene, H, settings=settings)
+            problem = prepare_step(scene, H)
+            guess = initial_guess(scene, problem, init)
+            t0 = time.perf_counter()
+            r, _, _ = solve_problem(scene, problem, guess, None, settings)
+            data[f"wall_time_{init}"].append(time.perf_counter() - t0)
+            data[f"sweeps_{init}"].append(r.sweeps)
+            data[f"residual_{init}"].append(r.residual)
+            data[f"converged_{init}"].append(int(r.converged))
+        if log is not None:
+            log.info("N = %d: sweeps zero %d, warm %d", n, data["sweeps_zero"][-1], data["sweeps_warm"][-1])
+    ds = xr.Dataset({k: ("size", np.asarray(v)) for k, v in data.items()},
+                    coords={"size": np.asarray(cfg["sizes"])})
+    ds.attrs.update(tol=cfg["tol"], max_sweeps=cfg["max_sweeps"], warm_steps=cfg["warm_steps"])
+    return ds
+
+
+def _digest(out):
+    h = hashlib.sha256()
+    for k in ("impulse", "vel", "spin", "sweeps", "residual", "change", "converged"):
+        h.update(np.ascontiguousarray(out[k]).tobytes())
+    return h.hexdigest()
+
+
+def ensemble_table(cfg, log=None):
+    """An ensemble of ``cfg["runs"]`` zero-guess NLGS runs with random review orders
+    on a packing of ``cfg["n_discs"]`` discs, on 1 and 2 threads (best of
+    ``cfg["repeat"]``): wall times, speed-up and whether the results are identical."""
+    scene = dense_packing(cfg["n_discs"])
+    problem = prepare_step(scene, H)
+    settings = SolverSettings(tol=cfg["tol"], max_sweeps=cfg["max_sweeps"], check_every=10)
+    explore(scene, problem, [0], 1, settings=settings, threads=1)      # warm-up
+    threads = np.asarray(cfg["threads"])
+    wall = np.zeros(len(threads))
+    digests = []
+    for i, th in enumerate(threads):
+        best = np.inf
+        for _ in range(cfg["repeat"]):
+            t0 = time.perf_counter()
+            out = explore(scene, problem, range(cfg["runs"]), cfg["root_seed"], settings=settings,
+                          threads=int(th))
+            best = min(best, time.perf_counter() - t0)
+        wall[i] = best
+        digests.append(_digest(out))
+        if log is not None:
+            log.info("%d threads: %.3f s, digest %s", th, best, digests[-1][:12])
+    ds = xr.Dataset({"wall_time": ("threads", wall), "speedup": ("threads", wall[0] / wall),
+                     "identical": ("threads", np.array([int(d == digests[0]) for d in digests])),
+                     "digest": ("threads", np.array(digests))},
+                    coords={"threads": threads})
+    ds.attrs.update(n_discs=scene.n_mobile, n_contacts=problem.contacts.n, runs=cfg["runs"],
+                    tol=cfg["tol"], sweeps_mean=float(np.mean(out["sweeps"])),
+                    converged=int(np.sum(out["converged"])), cpu_count=os.cpu_count())
+    return ds
+
+
+def environment():
+    """Machine and library versions, as dataset attributes."""
+    import platform
+
+    import numba
+    return {"python": platform.python_version(), "numpy": np.__version__, "numba": numba.__version__,
+            "machine": platform.machine(), "cpu_count": os.cpu_count(),
+            "numba_threads": numba.get_num_threads(), "loadavg_start": os.getloadavg()[0]}
+
+
+STARTUP = r"""
+import time
+t0 = time.perf_counter()
+import ncd
+t1 = time.perf_counter()
+scene = ncd.make_scene([[0.0, 0.5], [0.0, 1.5], [1.3, 0.6]], [0.5, 0.5, 0.6], walls=[((0, 0), (0, 1))])
+ncd.step(scene, 1e-3)
+t2 = time.perf_counter()
+print(t1 - t0, t2 - t1)
+"""
+
+
+def startup(repeat=3):
+    """Seconds to ``import ncd`` and to make a first step, and the whole process,
+    in fresh interpreters (the numba cache warmed by a first run)."""
+    cmd = [sys.executable, "-c", STARTUP]
+    subprocess.run(cmd, check=True, capture_output=True)
+    runs = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout.split()
+        runs.append((float(out[0]), float(out[1]), time.perf_counter() - t0))
+    imp, first, wall = np.min(np.array(runs), axis=0)
+    return {"import_s": imp, "first_step_s": first, "process_s": wall}
+
+
+def rule_times(paths):
+    """Wall time (s) and peak memory (MB) of every rule from Snakemake benchmark files
+    ``results/benchmarks/<figure>/<rule>.tsv``, as a Dataset over ``job``."""
+    rows = []
+    for p in sorted(Path(x) for x in paths):
+        lines = p.read_text().splitlines()
+        head, values = lines[0].split("\t"), lines[1].split("\t")
+        rec = dict(zip(head, values))
+        rss = rec.get("max_rss", "-")
+        rows.append((p.parent.name, p.stem, float(rec["s"]), float(rss) if rss not in ("-", "NA", "") else np.nan))
+    return xr.Dataset({"figure": ("job", [r[0] for r in rows]), "rule": ("job", [r[1] for r in rows]),
+                       "seconds": ("job", np.array([r[2] for r in rows])),
+                       "max_rss_mb": ("job", np.array([r[3] for r in rows]))},
+                      coords={"job": np.arange(len(rows))})

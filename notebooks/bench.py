@@ -1,0 +1,205 @@
+# ---
+# jupyter:
+#   jupytext:
+#     formats: ipynb,py:percent
+#     notebook_metadata_filter: language_info
+#     text_representation:
+#       extension: .py
+#       format_name: percent
+#       format_version: '1.3'
+#       jupytext_version: 1.19.6
+#   kernelspec:
+#     display_name: Python 3
+#     language: python
+#     name: python3
+#   language_info:
+#     name: python
+# ---
+
+# %% [markdown]
+# # Benchmarks: ncd against the hardware, against itself on two threads, and against pymunk
+#
+# **Why.** Contact Dynamics trades a stiff ODE for a nonsmooth problem per step
+# (Moreau 2005, section 2); its cost is the NLGS sweep, repeated many times per step in
+# dense packings.  A reader choosing between ncd, LMGC90, Siconos or a game engine
+# needs the cost of that sweep against what the machine can do, the growth of the
+# sweeps with N, the use of both cores in ensembles, and a peer on the same work.
+#
+# **What we computed** (`snakemake -j2 bench`, section `bench` of `config.yaml`;
+# every timing rule asks for both cores, so Snakemake runs it alone):
+#
+# * `core.nc`: on dense jittered triangular packings (about three contacts per
+#   disc, `ncd.studies.bench.dense_packing`), the time per contact update of the
+#   numba NLGS sweep, and of **the same loop in C** (`ncd/studies/c_sweep.c`, gcc
+#   `-O3 -march=native`, same packed arrays, same floating-point operations: it
+#   returns the same impulses), contact detection, step preparation, the time per
+#   Moreau–Jean step (warm start, fixed sweep budget) and the peak memory;
+# * `sweeps.nc`: the sweeps needed to reach a fixed natural-map residual on one
+#   step, from the zero guess and from the warm start;
+# * `ensemble.nc`: one ensemble of zero-guess NLGS runs with random review
+#   orders on 1 and 2 threads (`ncd.explore.run_parallel`): speed-up and a digest
+#   of every result, which must be the same;
+# * `peer.nc`: a pile poured from a point source, the same scene in ncd and in
+#   pymunk (Chipmunk2D, C, sequential impulses) with the same number of
+#   Gauss–Seidel iterations per step (`ncd.studies.peer`);
+# * `rules.nc`: the wall time of every rule of the figures' run, from Snakemake's
+#   `benchmark:` files.
+
+# %%
+import numpy as np
+import pandas as pd
+import xarray as xr
+import yaml
+import matplotlib
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+from IPython.display import display, Markdown
+
+try:
+    snakemake  # noqa: B018 (injected by Snakemake's notebook directive)
+except NameError:  # run by hand on the results of a finished run
+    from types import SimpleNamespace
+    snakemake = SimpleNamespace(
+        input=SimpleNamespace(**{k: f"../results/bench/{k}.nc" for k in ("core", "sweeps", "ensemble", "peer", "rules")}),
+        output=SimpleNamespace(png="bench.png", pdf="bench.pdf"))
+
+core = xr.load_dataset(snakemake.input.core)
+sweeps = xr.load_dataset(snakemake.input.sweeps)
+ens = xr.load_dataset(snakemake.input.ensemble)
+peer = xr.load_dataset(snakemake.input.peer)
+rules = xr.load_dataset(snakemake.input.rules)
+print(f"machine: {core.attrs['machine']}, {core.attrs['cpu_count']} cores; python {core.attrs['python']}, "
+      f"numba {core.attrs['numba']}; load average at start {core.attrs['loadavg_start']:.2f}")
+
+# %% [markdown]
+# ## The NLGS sweep against the same loop in C
+#
+# Time per contact update = time of a sweep / contacts, from the zero guess with the
+# identity review order (contacts sorted by body pair).  `ratio` is numba over C.
+
+# %%
+tab = core.to_dataframe()
+tab["ratio"] = tab.ns_per_update / tab.ns_per_update_c
+tab["detect_ms"] = 1e3 * tab.detect_s
+tab["prepare_ms"] = 1e3 * tab.prepare_s
+tab["step_ms"] = 1e3 * tab.step_s
+tab["step_us_per_disc"] = 1e6 * tab.step_s / tab.n_discs
+tab["peak_MB"] = tab.peak_memory / 2**20
+tab["growth_MB"] = tab.memory_growth / 2**20
+cols = ["n_discs", "n_contacts", "ns_per_update", "ns_per_update_c", "ratio", "c_agrees", "detect_ms",
+        "prepare_ms", "step_ms", "step_sweeps", "step_us_per_disc", "peak_MB", "growth_MB"]
+with pd.option_context("display.width", 250, "display.float_format", "{:.3g}".format):
+    display(tab[cols])
+start = {k[8:]: v for k, v in core.attrs.items() if k.startswith("startup_")}
+display(Markdown(
+    f"Sweep: **{tab.ns_per_update.min():.1f}–{tab.ns_per_update.max():.1f} ns** per contact update "
+    f"(C: {tab.ns_per_update_c.min():.1f}–{tab.ns_per_update_c.max():.1f} ns; numba/C "
+    f"{tab.ratio.min():.2f}–{tab.ratio.max():.2f}; the issue's target is 12 ns).  Time per step per "
+    f"disc: {tab.step_us_per_disc.min():.1f}–{tab.step_us_per_disc.max():.1f} µs at a budget of "
+    f"{yaml.safe_load(core.attrs['config_yaml'])['step_sweeps']} sweeps.  A fresh interpreter with a warm numba cache imports ncd in "
+    f"{start['import_s']:.2f} s and makes its first step {start['first_step_s']:.2f} s later "
+    f"(whole process {start['process_s']:.2f} s)."))
+
+# %% [markdown]
+# **Where the time goes.** Gauss–Seidel is sequential: the update of a contact reads
+# the velocities that the previous updates of its two discs wrote.  With contacts
+# sorted by body pair, consecutive updates share a disc, so each waits for the last
+# one's result (load, about twenty dependent floating-point operations, one division,
+# store): the loop is bound by that latency, in C as in numba.  Reordering the
+# reviews so that consecutive contacts share no disc (the graph colouring of Box2D's
+# solver) lets the processor overlap them (about 8 ns in C on this machine), but it
+# changes the sequence of iterates, hence every result of the figures in the last
+# bits and, through the flows' sensitivity, which steps show indeterminacy; we keep
+# the order and its results.
+
+# %% [markdown]
+# ## Sweeps against N
+
+# %%
+sw = sweeps.to_dataframe()
+with pd.option_context("display.width", 250, "display.float_format", "{:.3g}".format):
+    display(sw)
+ok = sw.converged_zero.astype(bool)
+slope = np.polyfit(np.log(sw.index[ok]), np.log(sw.sweeps_zero[ok]), 1)[0] if ok.sum() >= 2 else np.nan
+display(Markdown(
+    f"From the zero guess the sweeps to a residual of {sweeps.attrs['tol']:g} grow like "
+    f"N^{slope:.2f} (fit over the converged sizes; {int((~ok).sum())} size(s) exhausted "
+    f"{sweeps.attrs['max_sweeps']} sweeps): the load has to cross the packing, whose height "
+    f"grows like N^0.5.  Warm-started after {sweeps.attrs['warm_steps']} steps, "
+    f"{sw.sweeps_warm.min()}–{sw.sweeps_warm.max()} sweeps suffice."))
+
+# %% [markdown]
+# ## Ensembles on two threads
+
+# %%
+e = ens.to_dataframe()
+with pd.option_context("display.width", 250):
+    display(e)
+display(Markdown(
+    f"{ens.attrs['runs']} zero-guess runs ({ens.attrs['n_contacts']} contacts, mean "
+    f"{ens.attrs['sweeps_mean']:.0f} sweeps, {ens.attrs['converged']} converged): speed-up "
+    f"**{float(e.speedup.iloc[-1]):.2f}×** on {int(e.index[-1])} threads (target 1.8×); results "
+    f"{'identical bit for bit' if bool(e.identical.all()) else 'NOT identical'} for every thread count."))
+
+# %% [markdown]
+# ## Side by side with pymunk on a poured pile
+
+# %%
+pt = peer.to_dataframe().T
+with pd.option_context("display.width", 250, "display.max_rows", 100, "display.float_format", "{:.4g}".format):
+    display(pt)
+notes = {k: v for k, v in peer.attrs.items() if "version" in k}
+print(notes)
+
+# %% [markdown]
+# ## Wall time of every rule of the figures' run
+
+# %%
+rt = rules.to_dataframe()
+rt["name"] = rt.figure + "/" + rt.rule
+per_figure = rt.groupby("figure").seconds.sum()
+with pd.option_context("display.max_rows", 200, "display.width", 200):
+    display(rt[["figure", "rule", "seconds", "max_rss_mb"]])
+    display(per_figure.to_frame("seconds (sum of the figure's rules)"))
+display(Markdown(f"{len(rt)} jobs, {rt.seconds.sum() / 60:.1f} CPU-job minutes in all (with -j2 two "
+                 "run at a time; the wall time of the whole run is in the README)."))
+
+# %%
+fig, axes = plt.subplots(2, 2, figsize=(13, 9))
+ax = axes[0, 0]
+ax.plot(tab.n_discs, tab.ns_per_update, "o-", label="ncd (numba)")
+ax.plot(tab.n_discs, tab.ns_per_update_c, "s--", label="same loop in C (gcc -O3)")
+ax.axhline(12, color="k", lw=0.8, ls=":", label="target 12 ns")
+ax.set_xscale("log")
+ax.set_ylim(0, None)
+ax.set_xlabel("discs")
+ax.set_ylabel("ns per contact update")
+ax.set_title("(a) NLGS sweep")
+ax.legend()
+ax = axes[0, 1]
+ax.loglog(tab.n_discs, tab.step_s, "o-", label="step (warm, fixed budget)")
+ax.loglog(tab.n_discs, tab.prepare_s, "s-", label="step preparation (detection, W, q)")
+ax.loglog(tab.n_discs, tab.detect_s, "^-", label="detection")
+n = np.array([tab.n_discs.min(), tab.n_discs.max()], float)
+ax.loglog(n, tab.step_s.iloc[0] * n / n[0], "k:", lw=0.8, label="∝ N")
+ax.set_xlabel("discs")
+ax.set_ylabel("s")
+ax.set_title("(b) time per step")
+ax.legend(fontsize=8)
+ax = axes[1, 0]
+ax.loglog(sw.index, sw.sweeps_zero, "o-", label="zero guess")
+ax.loglog(sw.index, sw.sweeps_warm, "s-", label="warm start")
+ax.set_xlabel("discs")
+ax.set_ylabel(f"sweeps to residual {sweeps.attrs['tol']:g}")
+ax.set_title("(c) sweeps against N")
+ax.legend()
+ax = axes[1, 1]
+top = rt.sort_values("seconds", ascending=False).head(15)
+ax.barh(top.name, top.seconds)
+ax.invert_yaxis()
+ax.set_xlabel("s")
+ax.set_title("(d) slowest rules of the figures' run")
+ax.tick_params(axis="y", labelsize=7)
+fig.tight_layout()
+fig.savefig(snakemake.output.png, dpi=120)
+fig.savefig(snakemake.output.pdf)

@@ -1,0 +1,129 @@
+"""The benchmark suite (issue 6): what it measures must be right; its speed is not asserted.
+
+Unit checks of ncd.studies.bench on small packings, and checks of the data of the
+reduced DAG run (``snakemake -j2 bench`` in tests/conftest.py)."""
+import os
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+
+import ncd
+from ncd.explore import explore, run_parallel
+from ncd.studies import bench
+
+
+@pytest.fixture(scope="module")
+def packing():
+    scene = bench.dense_packing(300)
+    return scene, ncd.prepare_step(scene, bench.H)
+
+
+def test_dense_packing_has_about_three_contacts_per_disc(packing):
+    scene, problem = packing
+    assert 290 <= scene.n_mobile <= 320
+    assert 2.7 <= problem.contacts.n / scene.n_mobile <= 3.1
+
+
+@pytest.mark.skipif(shutil.which("gcc") is None and shutil.which("cc") is None, reason="no C compiler")
+def test_the_c_reference_runs_the_same_loop(packing, tmp_path):
+    """Same packed arrays, same operations in the same order: the same impulses."""
+    scene, problem = packing
+    t_numba, imp = bench.nlgs_sweep_cost(scene, problem, 7, 1)
+    t_c, c_sum = bench.c_sweep_cost(scene, problem, 7, tmp_path)
+    assert t_numba > 0 and t_c > 0
+    assert c_sum == pytest.approx(imp.sum(), rel=1e-12)
+    assert imp.sum() > 0
+
+
+def test_threads_give_the_same_ensemble_bit_for_bit(packing):
+    scene, problem = packing
+    settings = ncd.SolverSettings(tol=1e-5, max_sweeps=3000, check_every=10)
+    one = explore(scene, problem, range(6), 11, settings=settings, threads=1)
+    two = explore(scene, problem, range(6), 11, settings=settings, threads=2)
+    assert len(set(one["sweeps"])) > 1          # the members differ from each other ...
+    for k in ("impulse", "vel", "spin", "sweeps", "residual", "change", "converged"):
+        np.testing.assert_array_equal(one[k], two[k], err_msg=k)   # ... not with the threads
+    assert one["converged"].all()
+
+
+def test_run_parallel_reports_progress_in_order_and_raises_task_errors():
+    seen, done = [], []
+    run_parallel(lambda k: seen.append(k), 5, threads=2, progress=lambda d, n: done.append((d, n)))
+    assert sorted(seen) == list(range(5)) and done == [(k, 5) for k in range(1, 6)]
+
+    def fail(k):
+        if k == 3:
+            raise RuntimeError("member 3 failed")
+    with pytest.raises(RuntimeError, match="member 3"):
+        run_parallel(fail, 6, threads=2)
+    with pytest.raises(ValueError, match="threads"):
+        run_parallel(fail, 2, threads=0)
+
+
+def test_warm_start_needs_fewer_sweeps_than_the_zero_guess():
+    ds = bench.sweeps_table({"sizes": [100, 300], "tol": 1e-4, "max_sweeps": 20000, "warm_steps": 3})
+    assert ds.converged_zero.all() and ds.converged_warm.all()
+    assert (ds.residual_zero <= 1e-4).all() and (ds.residual_warm <= 1e-4).all()
+    assert (ds.sweeps_warm * 5 < ds.sweeps_zero).all()
+    assert ds.sweeps_zero[1] > ds.sweeps_zero[0]        # more layers, more sweeps
+
+
+def test_rule_times_reads_snakemake_benchmark_files(tmp_path):
+    d = tmp_path / "fig9"
+    d.mkdir()
+    head = "s\th:m:s\tmax_rss\tmax_vms\tmax_uss\tmax_pss\tio_in\tio_out\tmean_load\tcpu_time\n"
+    (d / "simulate.tsv").write_text(head + "12.5\t0:00:12\t250.5\t900\t200\t210\t0\t1\t95\t12\n")
+    (d / "notebook.tsv").write_text(head + "3.0\t0:00:03\t-\t-\t-\t-\t-\t-\t-\t-\n")
+    ds = bench.rule_times(d.glob("*.tsv"))
+    assert list(ds.rule.values) == ["notebook", "simulate"]
+    assert list(ds.figure.values) == ["fig9", "fig9"]
+    np.testing.assert_allclose(ds.seconds, [3.0, 12.5])
+    assert np.isnan(ds.max_rss_mb[0]) and ds.max_rss_mb[1] == 250.5
+
+
+@pytest.mark.skipif(not Path("/proc/self/status").exists(), reason="Linux only")
+def test_peak_memory_sees_an_allocation():
+    with bench.PeakMemory() as mem:
+        a = np.ones(50_000_000 // 8)
+        a.sum()
+    assert mem.growth >= 0.9 * 50_000_000
+    assert mem.peak >= mem.growth
+
+
+# ----------------------------------------------------------- data of the DAG run
+@pytest.fixture(scope="module")
+def bench_results(results):
+    d = results / "bench"
+    if not (d / "core.nc").exists():
+        pytest.skip(f"no benchmark results in {d} (run `snakemake -j2 bench`)")
+    return {k: xr.load_dataset(d / f"{k}.nc") for k in ("core", "sweeps", "ensemble", "peer", "rules")}
+
+
+def test_bench_core_data(bench_results):
+    core = bench_results["core"]
+    assert (core.n_contacts > 2.5 * core.n_discs).all()
+    assert (core.ns_per_update > 0).all() and np.isfinite(core.ns_per_update).all()
+    if np.isfinite(core.ns_per_update_c).all():
+        assert (core.c_agrees == 1).all()
+    assert (core.prepare_s >= core.detect_s).all()
+    assert core.attrs["startup_import_s"] > 0 and "git_commit" in core.attrs
+
+
+def test_bench_ensemble_is_identical_on_every_thread_count(bench_results):
+    ens = bench_results["ensemble"]
+    assert (ens.identical == 1).all()
+    assert len(set(ens.digest.values)) == 1
+    assert ens.speedup.sel(threads=1) == 1.0
+
+
+def test_bench_rules_cover_every_figure(bench_results):
+    rules = bench_results["rules"]
+    figures = set(rules.figure.values)
+    assert {"fig1_wedged", "fig2_slope", "fig3_equilibrium", "fig4_pile"} <= figures
+    for fig in figures:
+        names = set(rules.rule.values[rules.figure.values == fig])
+        assert any(n.endswith("notebook") for n in names), (fig, names)
+    assert (rules.seconds > 0).all()

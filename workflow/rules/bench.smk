@@ -1,0 +1,118 @@
+# Benchmark suite (issue 6): `snakemake -j2 bench`, not part of the default target.
+#   core      ns per contact update (numba and the same loop in C), detection,
+#             time per step and memory on dense packings       -> results/bench/core.nc
+#   sweeps    sweeps to a fixed tolerance against N             -> results/bench/sweeps.nc
+#   ensemble  NLGS ensemble on 1 and 2 threads                  -> results/bench/ensemble.nc
+#   peer      ncd and pymunk side by side on a poured pile      -> results/bench/peer.nc
+#   rules     wall time of every rule of the figures' run       -> results/bench/rules.nc
+#   notebook  notebooks/bench.ipynb                             -> results/figures/bench.png|pdf
+# Every timing rule asks for all the cores (threads: BENCH_THREADS), so that with -j2
+# Snakemake runs it alone: no other job competes with what it measures.
+FIGB = "bench"
+CFGB = section(FIGB)
+BENCH_THREADS = 2
+
+
+rule bench_core:
+    input:
+        ncd_sources(FIGB),
+    output:
+        "results/bench/core.nc",
+    threads: BENCH_THREADS
+    params:
+        config=CFGB["core"],
+    log:
+        log(FIGB, "core"),
+    benchmark:
+        bench(FIGB, "core")
+    script:
+        "../scripts/bench_core.py"
+
+
+rule bench_sweeps:
+    input:
+        ncd_sources(FIGB),
+    output:
+        "results/bench/sweeps.nc",
+    threads: BENCH_THREADS
+    params:
+        config=CFGB["sweeps"],
+    log:
+        log(FIGB, "sweeps"),
+    benchmark:
+        bench(FIGB, "sweeps")
+    script:
+        "../scripts/bench_sweeps.py"
+
+
+rule bench_ensemble:
+    input:
+        ncd_sources(FIGB),
+    output:
+        "results/bench/ensemble.nc",
+    threads: BENCH_THREADS
+    params:
+        config=CFGB["ensemble"],
+    log:
+        log(FIGB, "ensemble"),
+    benchmark:
+        bench(FIGB, "ensemble")
+    script:
+        "../scripts/bench_ensemble.py"
+
+
+rule bench_peer:
+    input:
+        ncd_sources(FIGB),
+    output:
+        "results/bench/peer.nc",
+    threads: BENCH_THREADS
+    params:
+        config=CFGB["peer"],
+    log:
+        log(FIGB, "peer"),
+    benchmark:
+        bench(FIGB, "peer")
+    script:
+        "../scripts/bench_peer.py"
+
+
+rule bench_rules:
+    """The wall time of every rule of the figures (their benchmark files, after their run)."""
+    input:
+        [figure_targets(f) for f in FIGURES],
+    output:
+        "results/bench/rules.nc",
+    params:
+        pattern="results/benchmarks/*/*.tsv",
+        figures=FIGURES,
+    log:
+        log(FIGB, "rules"),
+    benchmark:
+        bench(FIGB, "rules")
+    script:
+        "../scripts/bench_rules.py"
+
+
+rule bench_notebook:
+    input:
+        core="results/bench/core.nc",
+        sweeps="results/bench/sweeps.nc",
+        ensemble="results/bench/ensemble.nc",
+        peer="results/bench/peer.nc",
+        rules="results/bench/rules.nc",
+        notebook=str(ROOT / "notebooks" / "bench.ipynb"),
+    output:
+        png="results/figures/bench.png",
+        pdf="results/figures/bench.pdf",
+    log:
+        notebook="results/notebooks/bench.ipynb",
+    benchmark:
+        bench(FIGB, "notebook")
+    notebook:
+        "../../notebooks/bench.ipynb"
+
+
+rule bench:
+    input:
+        figure_targets(FIGB),
