@@ -50,10 +50,14 @@ class Contacts:
         return Contacts(**{k: v[mask] for k, v in self.__dict__.items()})
 
 
+@njit(cache=True)
 def pair_key(body_a, body_b, n_disc):
     """One int64 per body pair; walls come after all discs."""
-    b = np.where(body_b >= 0, body_b, n_disc - 1 - body_b)
-    return body_a.astype(np.int64) * (n_disc + 1024) + b
+    key = np.empty(body_a.shape[0], np.int64)
+    for c in range(body_a.shape[0]):
+        b = body_b[c] if body_b[c] >= 0 else n_disc - 1 - body_b[c]
+        key[c] = np.int64(body_a[c]) * (n_disc + 1024) + b
+    return key
 
 
 def detect_contacts(scene, alert=0.0, pos=None):
@@ -66,34 +70,74 @@ def detect_contacts(scene, alert=0.0, pos=None):
     pos = scene.pos if pos is None else pos
     nm = scene.n_mobile
     a, b, shift = disc_pairs(pos, scene.radius, nm, alert, scene.period)
-    d = pos[a] - pos[b]
-    d[:, 0] -= shift
-    dist = np.hypot(d[:, 0], d[:, 1])
-    normal = d / np.where(dist > 0, dist, 1.0)[:, None]
-    gap = dist - scene.radius[a] - scene.radius[b]
-    arm_a, arm_b = scene.radius[a], scene.radius[b]
-    obstacle = b >= nm
-    parts = [(a, b, normal, gap, arm_a, arm_b, shift, obstacle)]
-    for k in range(len(scene.wall_point)):
-        wn = scene.wall_normal[k]
-        wg = (pos[:nm] - scene.wall_point[k]) @ wn - scene.radius[:nm]
-        (i,) = np.nonzero(wg <= alert)
-        parts.append((i, np.full(len(i), -1 - k), np.tile(wn, (len(i), 1)), wg[i],
-                      scene.radius[i], np.zeros(len(i)), np.zeros(len(i)), np.ones(len(i), bool)))
-    a, b, normal, gap, arm_a, arm_b, shift, obstacle = (np.concatenate(x) for x in zip(*parts))
-    a = a.astype(np.int64)
-    b = b.astype(np.int64)
-    key = pair_key(a, b, scene.n_disc)
-    order = np.argsort(key, kind="stable")
-    a, b, normal, gap, arm_a, arm_b, shift, obstacle, key = (
-        x[order] for x in (a, b, normal.reshape(-1, 2), gap, arm_a, arm_b, shift, obstacle, key))
-    point = pos[a] - (arm_a + 0.5 * gap)[:, None] * normal
-    return Contacts(
-        body_a=a, body_b=b, normal=normal, point=point, gap=gap, arm_a=arm_a, arm_b=arm_b,
-        shift_b=shift, key=key,
-        mu=np.where(obstacle, scene.mu_obstacle, scene.mu),
-        e_n=np.where(obstacle, scene.e_n_obstacle, scene.e_n),
-        e_t=np.where(obstacle, scene.e_t_obstacle, scene.e_t))
+    n_walls = len(scene.wall_point)
+    wall_gap = np.empty((n_walls, nm))
+    for k in range(n_walls):
+        wall_gap[k] = (pos[:nm] - scene.wall_point[k]) @ scene.wall_normal[k] - scene.radius[:nm]
+    laws = np.array([scene.mu, scene.e_n, scene.e_t, scene.mu_obstacle, scene.e_n_obstacle,
+                     scene.e_t_obstacle], dtype=float)
+    fields = _assemble(pos, scene.radius, nm, scene.n_disc, a.astype(np.int64), b.astype(np.int64), shift,
+                       wall_gap, np.asarray(scene.wall_normal, dtype=float).reshape(n_walls, 2),
+                       float(alert), laws)
+    return Contacts(*fields)
+
+
+@njit(cache=True)
+def _assemble(pos, radius, nm, n_disc, a, b, shift, wall_gap, wall_normal, alert, laws):
+    """The fields of :class:`Contacts` (in its order) from the disc pairs ``(a, b,
+    shift)`` and the disc-wall gaps ``wall_gap`` (n_walls, nm), sorted by pair key.
+
+    ``laws``: mu, e_n, e_t between discs, then the same with obstacles (fixed
+    discs and walls).  The normal is ``d / |d|`` with ``d`` from b (or its
+    periodic image) to a; the point is the middle of the gap."""
+    n_pairs = a.shape[0]
+    n_walls = wall_gap.shape[0]
+    n = n_pairs
+    for k in range(n_walls):
+        for i in range(nm):
+            if wall_gap[k, i] <= alert:
+                n += 1
+    A = np.empty(n, np.int64)
+    B = np.empty(n, np.int64)
+    normal = np.empty((n, 2))
+    gap = np.empty(n)
+    arm_a = np.empty(n)
+    arm_b = np.empty(n)
+    sh = np.zeros(n)
+    for c in range(n_pairs):
+        i, j = a[c], b[c]
+        dx = pos[i, 0] - pos[j, 0] - shift[c]
+        dy = pos[i, 1] - pos[j, 1]
+        dist = np.hypot(dx, dy)
+        den = dist if dist > 0 else 1.0
+        A[c], B[c], sh[c] = i, j, shift[c]
+        normal[c, 0] = dx / den
+        normal[c, 1] = dy / den
+        gap[c] = dist - radius[i] - radius[j]
+        arm_a[c], arm_b[c] = radius[i], radius[j]
+    c = n_pairs
+    for k in range(n_walls):
+        for i in range(nm):
+            if wall_gap[k, i] <= alert:
+                A[c], B[c] = i, -1 - k
+                normal[c, 0], normal[c, 1] = wall_normal[k, 0], wall_normal[k, 1]
+                gap[c], arm_a[c], arm_b[c] = wall_gap[k, i], radius[i], 0.0
+                c += 1
+    key = pair_key(A, B, n_disc)
+    order = np.argsort(key, kind="mergesort")
+    out_normal = np.empty((n, 2))
+    point = np.empty((n, 2))
+    law = np.empty((n, 3))
+    for m in range(n):
+        c = order[m]
+        out_normal[m, 0], out_normal[m, 1] = normal[c, 0], normal[c, 1]
+        w = arm_a[c] + 0.5 * gap[c]
+        point[m, 0] = pos[A[c], 0] - w * normal[c, 0]
+        point[m, 1] = pos[A[c], 1] - w * normal[c, 1]
+        first = 3 if B[c] >= nm or B[c] < 0 else 0
+        law[m, 0], law[m, 1], law[m, 2] = laws[first], laws[first + 1], laws[first + 2]
+    return (A[order], B[order], out_normal, point, gap[order], arm_a[order], arm_b[order], sh[order],
+            key[order], law[:, 0].copy(), law[:, 1].copy(), law[:, 2].copy())
 
 
 @njit(cache=True)
@@ -134,13 +178,22 @@ def local_velocity(body_a, body_b, normal, arm_a, arm_b, vel, spin, out):
 
 def match_warm(contacts, prev_keys, prev_impulse):
     """Previous impulses of persisting contacts (matched by body pair), zero elsewhere."""
-    guess = np.zeros((contacts.n, 2))
     if prev_keys is None or len(prev_keys) == 0 or contacts.n == 0:
-        return guess
-    idx = np.searchsorted(prev_keys, contacts.key)
-    idx = np.minimum(idx, len(prev_keys) - 1)
-    hit = prev_keys[idx] == contacts.key
-    guess[hit] = prev_impulse[idx[hit]]
+        return np.zeros((contacts.n, 2))
+    return _match_sorted(contacts.key, np.asarray(prev_keys, dtype=np.int64), prev_impulse)
+
+
+@njit(cache=True)
+def _match_sorted(keys, prev_keys, prev_impulse):
+    """Both key lists sorted: one merge pass."""
+    guess = np.zeros((keys.shape[0], 2))
+    j = 0
+    for c in range(keys.shape[0]):
+        while j < prev_keys.shape[0] and prev_keys[j] < keys[c]:
+            j += 1
+        if j < prev_keys.shape[0] and prev_keys[j] == keys[c]:
+            guess[c, 0] = prev_impulse[j, 0]
+            guess[c, 1] = prev_impulse[j, 1]
     return guess
 
 

@@ -30,7 +30,7 @@ from numba import njit
 NO_CONTACT, STICK, SLIDE_FORWARD, SLIDE_BACKWARD, FALLBACK = 0, 1, 2, 3, 4
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def project_cone(zn, zt, mu):
     """Euclidean projection of ``(zn, zt)`` onto the Coulomb cone ``|r_t| <= mu r_n``."""
     at = abs(zt)
@@ -43,7 +43,7 @@ def project_cone(zn, zt, mu):
     return pn, pt
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def solve_single_contact(wnn, wnt, wtn, wtt, qn, qt, mu):
     """Exact solution of the single-contact Coulomb problem ``U = W r + q``.
 
@@ -75,7 +75,7 @@ def solve_single_contact(wnn, wnt, wtn, wtt, qn, qt, mu):
     return pn, pt, FALLBACK
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def natural_map_sq(rn, rt, un, ut, mu, rho):
     """Squared norm of the natural map ``r - proj_K(r - rho U~)`` for one contact."""
     zn = rn - rho * (un + mu * abs(ut))

@@ -179,7 +179,7 @@ def _apply_all(pair, coef, body, imp):
         _add_impulse(pair, coef, body, c, imp[2 * c], imp[2 * c + 1])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _sweep_discs(data, order, status):
     pair, coef, body, imp = data
     dsum = 0.0
@@ -208,7 +208,7 @@ def _sweep_discs(data, order, status):
     return dsum, ssum
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _residual_discs(data):
     pair, coef, body, imp = data
     rsq = 0.0
@@ -222,7 +222,7 @@ def _residual_discs(data):
     return rsq, ssq
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, error_model="numpy")
 def _iterate_discs(data, order, status, scale, tol, max_sweeps, criterion, check_every):
     """The NLGS driver (disc form): sweeps until the criterion holds or ``max_sweeps``."""
     change = np.inf
@@ -250,9 +250,17 @@ def restitution_bias(contacts, U_initial):
     since the Coulomb law is invariant under positive scaling of each velocity
     component, this is the law on ``U_f + e U_i``.
     """
-    approaching = U_initial[:, 0] < 0.0
-    return np.where(approaching[:, None],
-                    np.column_stack([contacts.e_n, contacts.e_t]) * U_initial, 0.0)
+    return _restitution_bias(contacts.e_n, contacts.e_t, U_initial)
+
+
+@njit(cache=True)
+def _restitution_bias(e_n, e_t, U_initial):
+    bias = np.zeros_like(U_initial)
+    for c in range(U_initial.shape[0]):
+        if U_initial[c, 0] < 0.0:
+            bias[c, 0] = e_n[c] * U_initial[c, 0]
+            bias[c, 1] = e_t[c] * U_initial[c, 1]
+    return bias
 
 
 def solve_discs(scene, contacts, vel, spin, guess=None, review_order=None,
@@ -287,7 +295,7 @@ def solve_discs(scene, contacts, vel, spin, guess=None, review_order=None,
 
 
 # ---------------------------------------------------------------- local form
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _local_U(indptr, indices, values, q, flat, row):
     u = q[row]
     for j in range(indptr[row], indptr[row + 1]):
@@ -295,7 +303,7 @@ def _local_U(indptr, indices, values, q, flat, row):
     return u
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _sweep_local(data, order, status):
     indptr, indices, values, q, Wd, mu, flat = data
     dsum = 0.0
@@ -315,7 +323,7 @@ def _sweep_local(data, order, status):
     return dsum, ssum
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _residual_local(data):
     indptr, indices, values, q, Wd, mu, flat = data
     rsq = 0.0
@@ -328,7 +336,7 @@ def _residual_local(data):
     return rsq, ssq
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, error_model="numpy")
 def _iterate_local(data, order, status, scale, tol, max_sweeps, criterion, check_every):
     """The NLGS driver (local form): sweeps until the criterion holds or ``max_sweeps``."""
     change = np.inf

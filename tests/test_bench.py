@@ -114,7 +114,7 @@ def test_bench_core_data(bench_results):
 
 def test_bench_ensemble_is_identical_on_every_thread_count(bench_results):
     ens = bench_results["ensemble"]
-    assert (ens.identical == 1).all()
+    assert (ens["same_results"] == 1).all()
     assert len(set(ens.digest.values)) == 1
     assert ens.speedup.sel(threads=1) == 1.0
 
