@@ -199,6 +199,7 @@ fig, axes = plt.subplots(2, 2, figsize=(13, 9))
 ax = axes[0, 0]
 ax.plot(tab.n_discs, tab.ns_per_update, "o-", label="ncd (numba)")
 ax.plot(tab.n_discs, tab.ns_per_update_c, "s--", label="same loop in C (gcc -O3)")
+ax.plot(tab.n_discs, tab.ns_per_update_interleaved, "^:", label="ncd, interleaved review order")
 ax.axhline(12, color="k", lw=0.8, ls=":", label="target 12 ns")
 ax.set_xscale("log")
 ax.set_ylim(0, None)

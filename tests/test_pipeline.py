@@ -2,6 +2,7 @@
 import json
 import os
 import re
+import time
 from pathlib import Path
 
 import numpy as np
@@ -173,3 +174,41 @@ def test_every_ncd_module_is_a_source_of_the_figures_that_import_it():
     own = {str(p.relative_to(ROOT / "ncd")) for d in ("figures", "studies") for p in (ROOT / "ncd" / d).iterdir()
            if p.suffix in (".py", ".c")}
     assert own == listed, own ^ listed
+
+
+ALL_FIGURES = FIGURES + [f for f in ("stability", "error_vs_runtime") if f in CONFIG]
+OWN_MODULE = {"fig1_wedged": "figures/wedged.py", "fig2_slope": "figures/slope_analysis.py",
+              "fig3_equilibrium": "figures/equilibrium.py", "fig4_pile": "figures/cuts.py",
+              "stability": "studies/stability.py", "error_vs_runtime": "studies/work_precision.py"}
+
+
+@pytest.mark.parametrize("figure", ALL_FIGURES)
+def test_a_figure_target_plans_only_its_own_rules(fresh_repo, figure):
+    jobs = planned_jobs(run_snakemake(fresh_repo, "-n", figure))
+    assert f"{figure}_notebook" in jobs
+    assert all(r.startswith(figure) or r == "render_html" for r in jobs), jobs
+
+
+@pytest.mark.parametrize("figure", ALL_FIGURES)
+def test_editing_a_figure_module_reruns_that_figure_only(dag_repo, figure):
+    """A newer ncd/figures (or studies) module reruns its figure's computing rules and
+    nothing of the other figures; a newer core module reruns every figure."""
+    def plan_after_touching(rel):
+        # an edit (a new mtime and new content: Snakemake 9 skips a newer file whose
+        # checksum it recorded unchanged), undone afterwards with its mtime
+        path = dag_repo / "ncd" / rel
+        original, st = path.read_text(), path.stat()
+        try:
+            path.write_text(original + "\n# an edit\n")
+            os.utime(path, ns=(st.st_atime_ns, time.time_ns() + 10**12))     # newer than any output
+            return planned_jobs(run_snakemake(dag_repo, "-n"))
+        finally:
+            path.write_text(original)
+            os.utime(path, ns=(st.st_atime_ns, st.st_mtime_ns))
+
+    jobs = plan_after_touching(OWN_MODULE[figure])
+    assert any(r.startswith(figure) and not r.endswith("notebook") for r in jobs), jobs
+    assert all(r.startswith(figure) or r in ("render_html", "all") for r in jobs), jobs
+    if figure == ALL_FIGURES[0]:
+        core = plan_after_touching("nlgs.py")
+        assert {f"{f}_notebook" for f in ALL_FIGURES} <= set(core), core
