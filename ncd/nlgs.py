@@ -91,10 +91,12 @@ def _done(res, change, tol, criterion):
 # Data layout of the hot loop (one job: make a contact update a few cache-line
 # reads): ``body`` (n_disc + 1, 4) holds ``(v_x, v_y, omega, 0)`` per disc, the
 # last row a motionless dummy that stands for every wall; ``pair`` (n, 2) the
-# two body rows of a contact; ``coef`` (n, 16) everything else a contact update
-# reads, in the order of the ``C_*`` columns below.
-C_NX, C_NY, C_RA, C_RB, C_WNN, C_WNT, C_WTN, C_WTT, C_MU, C_BN, C_BT, C_IMA, C_IIA, C_IMB, C_IIB = range(15)
-N_COEF = 16
+# two body rows of a contact (int32); ``coef`` (n, 13) everything else a contact update
+# reads, in the order of the ``C_*`` columns below.  The Delassus block of a disc
+# contact is diagonal (the normal line passes through both centres), so the sweep
+# passes ``W_nt = W_tn = 0`` to the single-contact solver.
+C_NX, C_NY, C_RA, C_RB, C_WNN, C_WTT, C_MU, C_BN, C_BT, C_IMA, C_IIA, C_IMB, C_IIB = range(13)
+N_COEF = 13
 
 
 @njit(cache=True, nogil=True)
@@ -111,7 +113,7 @@ def pack_problem(body_a, body_b, normal, arm_a, arm_b, W, mu, bias, inv_mass, in
         body[i, 0] = vel[i, 0]
         body[i, 1] = vel[i, 1]
         body[i, 2] = spin[i]
-    pair = np.empty((n, 2), np.int64)
+    pair = np.empty((n, 2), np.int32)
     coef = np.zeros((n, N_COEF))
     for c in range(n):
         a = body_a[c]
@@ -123,8 +125,6 @@ def pack_problem(body_a, body_b, normal, arm_a, arm_b, W, mu, bias, inv_mass, in
         coef[c, C_RA] = arm_a[c]
         coef[c, C_RB] = arm_b[c]
         coef[c, C_WNN] = W[c, 0, 0]
-        coef[c, C_WNT] = W[c, 0, 1]
-        coef[c, C_WTN] = W[c, 1, 0]
         coef[c, C_WTT] = W[c, 1, 1]
         coef[c, C_MU] = mu[c]
         coef[c, C_BN] = bias[c, 0]
@@ -189,8 +189,8 @@ def _sweep_discs(data, order, status):
         un, ut = _relative_velocity(pair, coef, body, c)
         j = N_COEF * c
         wnn = coef[j + C_WNN]
-        wnt = coef[j + C_WNT]
-        wtn = coef[j + C_WTN]
+        wnt = 0.0
+        wtn = 0.0
         wtt = coef[j + C_WTT]
         sn = imp[2 * c]
         st = imp[2 * c + 1]
@@ -281,6 +281,9 @@ def solve_discs(scene, contacts, vel, spin, guess=None, review_order=None,
     bias = np.zeros((n, 2)) if bias is None else bias
     c = contacts
     W = delassus_blocks(c.body_a, c.body_b, c.arm_a, c.arm_b, scene.inv_mass, scene.inv_inertia) if W is None else W
+    if np.any(W[:, 0, 1] != 0.0) or np.any(W[:, 1, 0] != 0.0):
+        raise ValueError("disc contacts have diagonal Delassus blocks: W[:, 0, 1] and W[:, 1, 0] must be 0 "
+                         "(use solve_local for a general W)")
     q_free = local_velocity(c.body_a, c.body_b, c.normal, c.arm_a, c.arm_b, vel, spin, np.empty((n, 2))) + bias
     pair, coef, body = pack_problem(c.body_a, c.body_b, c.normal, c.arm_a, c.arm_b, W, c.mu, bias,
                                     scene.inv_mass, scene.inv_inertia, vel, spin)

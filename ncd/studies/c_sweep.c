@@ -1,8 +1,9 @@
 /* The NLGS sweep of ncd (ncd/nlgs.py: _sweep_discs, solve_single_contact) in
  * plain C, on the same packed arrays, as the hardware reference of
  * ncd/studies/bench.py (nlgs_sweep_cost).  Input: a raw file written by ncd.studies.bench
- *   int64 n, n_body, sweeps; int64 order[n]; int64 pair[n][2];
- *   double coef[n][16]; double body[n_body][4]; double imp[n][2]
+ *   int64 n, n_body, sweeps; int64 order[n]; int32 pair[n][2];
+ *   double coef[n][13]; double body[n_body][4]; double imp[n][2]
+ * The Delassus blocks of disc contacts are diagonal (W_nt = W_tn = 0).
  * Output (stdout): seconds per sweep (best of 3 runs of `sweeps` sweeps)
  * and a checksum of the impulses.  Build: gcc -O3 -march=native -o c_sweep c_sweep.c
  */
@@ -13,7 +14,7 @@
 #include <string.h>
 #include <time.h>
 
-enum { NX, NY, RA, RB, WNN, WNT, WTN, WTT, MU, BN, BT, IMA, IIA, IMB, IIB, NCOEF = 16 };
+enum { NX, NY, RA, RB, WNN, WTT, MU, BN, BT, IMA, IIA, IMB, IIB, NCOEF = 13 };
 
 static void project_cone(double zn, double zt, double mu, double *pn, double *pt) {
     double at = fabs(zt);
@@ -40,7 +41,7 @@ static int solve(double wnn, double wnt, double wtn, double wtt, double qn, doub
     return 4;
 }
 
-static void sweep(int64_t n, const int64_t *order, const int64_t *pair, const double *coef,
+static void sweep(int64_t n, const int64_t *order, const int32_t *pair, const double *coef,
                   double *body, double *imp, int8_t *status, double *dsum_, double *ssum_) {
     double dsum = 0.0, ssum = 0.0;
     for (int64_t k = 0; k < n; k++) {
@@ -50,10 +51,10 @@ static void sweep(int64_t n, const int64_t *order, const int64_t *pair, const do
         double vx = ba[0] - bb[0], vy = ba[1] - bb[1], wt = p[RA] * ba[2] + p[RB] * bb[2];
         double un = vx * p[NX] + vy * p[NY], ut = -vx * p[NY] + vy * p[NX] - wt;
         double sn = imp[2 * c], st = imp[2 * c + 1];
-        double qn = un - p[WNN] * sn - p[WNT] * st + p[BN];
-        double qt = ut - p[WTN] * sn - p[WTT] * st + p[BT];
+        double qn = un - p[WNN] * sn - 0.0 * st + p[BN];
+        double qt = ut - 0.0 * sn - p[WTT] * st + p[BT];
         double rn, rt;
-        status[c] = (int8_t)solve(p[WNN], p[WNT], p[WTN], p[WTT], qn, qt, p[MU], &rn, &rt);
+        status[c] = (int8_t)solve(p[WNN], 0.0, 0.0, p[WTT], qn, qt, p[MU], &rn, &rt);
         double dn = rn - sn, dt = rt - st;
         imp[2 * c] = rn; imp[2 * c + 1] = rt;
         double px = dn * p[NX] - dt * p[NY], py = dn * p[NY] + dt * p[NX];
@@ -78,7 +79,8 @@ int main(int argc, char **argv) {
     int64_t hdr[3];
     if (fread(hdr, sizeof hdr, 1, f) != 1) { fprintf(stderr, "short input\n"); return 1; }
     int64_t n = hdr[0], nb = hdr[1], sweeps = hdr[2];
-    int64_t *order = load(f, 8 * n), *pair = load(f, 16 * n);
+    int64_t *order = load(f, 8 * n);
+    int32_t *pair = load(f, 8 * n);
     double *coef = load(f, 8 * NCOEF * n), *body0 = load(f, 32 * nb), *imp0 = load(f, 16 * n);
     fclose(f);
     double *body = malloc(32 * nb), *imp = malloc(16 * n), best = 1e300, dsum = 0, ssum = 0;
