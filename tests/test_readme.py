@@ -19,3 +19,13 @@ def test_readme_example_matches_closed_form():
         expected = float(re.search(rf"{mode} ([-\d.]+)", line).group(1))
         assert abs(a - expected) < 1e-3, line
         assert "converged=True" in line
+
+
+def test_readme_thumbnails_exist_for_every_figure():
+    readme = (ROOT / "README.md").read_text()
+    figures = ["fig1_wedged", "fig2_slope", "fig3_equilibrium", "fig4_pile", "stability", "error_vs_runtime"]
+    shown = re.findall(r'<img src="(docs/thumbnails/[\w]+\.png)"', readme)
+    assert shown == [f"docs/thumbnails/{f}.png" for f in figures]
+    for rel in shown:
+        data = (ROOT / rel).read_bytes()
+        assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 5_000, rel

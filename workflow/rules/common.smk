@@ -84,3 +84,23 @@ rule render_html:
     shell:
         "jupyter nbconvert --to html --output-dir results/html --output {wildcards.figure} "
         "{params.executed} > {log} 2>&1"
+
+
+rule thumbnail:
+    """A small copy of a figure for the README (docs/thumbnails, committed)."""
+    input:
+        "results/figures/{figure}.png",
+    output:
+        "docs/thumbnails/{figure}.png",
+    log:
+        "results/logs/{figure}/thumbnail.log",
+    benchmark:
+        "results/benchmarks/{figure}/thumbnail.tsv"
+    script:
+        "../scripts/thumbnail.py"
+
+
+rule thumbnails:
+    """`snakemake -j2 thumbnails`: refresh the README's thumbnails (not in the default target)."""
+    input:
+        [f"docs/thumbnails/{f}.png" for f in FIGURES],
