@@ -189,14 +189,12 @@ def _sweep_discs(data, order, status):
         un, ut = _relative_velocity(pair, coef, body, c)
         j = N_COEF * c
         wnn = coef[j + C_WNN]
-        wnt = 0.0
-        wtn = 0.0
         wtt = coef[j + C_WTT]
         sn = imp[2 * c]
         st = imp[2 * c + 1]
-        qn = un - wnn * sn - wnt * st + coef[j + C_BN]
-        qt = ut - wtn * sn - wtt * st + coef[j + C_BT]
-        rn, rt, st_ = solve_single_contact(wnn, wnt, wtn, wtt, qn, qt, coef[j + C_MU])
+        qn = un - wnn * sn + coef[j + C_BN]
+        qt = ut - wtt * st + coef[j + C_BT]
+        rn, rt, st_ = solve_single_contact(wnn, 0.0, 0.0, wtt, qn, qt, coef[j + C_MU])
         status[c] = st_
         dn = rn - sn
         dt = rt - st

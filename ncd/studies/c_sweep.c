@@ -51,8 +51,8 @@ static void sweep(int64_t n, const int64_t *order, const int32_t *pair, const do
         double vx = ba[0] - bb[0], vy = ba[1] - bb[1], wt = p[RA] * ba[2] + p[RB] * bb[2];
         double un = vx * p[NX] + vy * p[NY], ut = -vx * p[NY] + vy * p[NX] - wt;
         double sn = imp[2 * c], st = imp[2 * c + 1];
-        double qn = un - p[WNN] * sn - 0.0 * st + p[BN];
-        double qt = ut - 0.0 * sn - p[WTT] * st + p[BT];
+        double qn = un - p[WNN] * sn + p[BN];
+        double qt = ut - p[WTT] * st + p[BT];
         double rn, rt;
         status[c] = (int8_t)solve(p[WNN], 0.0, 0.0, p[WTT], qn, qt, p[MU], &rn, &rt);
         double dn = rn - sn, dt = rt - st;
