@@ -17,8 +17,8 @@ tangential per mobile disc).
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
+from ._cache import njit
 from .detection import disc_pairs
 
 

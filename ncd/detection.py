@@ -9,7 +9,8 @@ should an alert distance leave fewer than three columns, duplicate pairs are
 removed).
 """
 import numpy as np
-from numba import njit
+
+from ._cache import njit
 
 
 @njit(cache=True)

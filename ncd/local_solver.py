@@ -25,7 +25,8 @@ Coulomb problem with De Saxce's modified velocity
 which vanishes exactly at solutions (``rho = 1 / W_nn`` makes it an impulse).
 """
 import numpy as np
-from numba import njit
+
+from ._cache import njit
 
 NO_CONTACT, STICK, SLIDE_FORWARD, SLIDE_BACKWARD, FALLBACK = 0, 1, 2, 3, 4
 
@@ -34,7 +35,7 @@ NO_CONTACT, STICK, SLIDE_FORWARD, SLIDE_BACKWARD, FALLBACK = 0, 1, 2, 3, 4
 def project_cone(zn, zt, mu):
     """Euclidean projection of ``(zn, zt)`` onto the Coulomb cone ``|r_t| <= mu r_n``."""
     at = abs(zt)
-    if at <= mu * zn:
+    if zn >= 0.0 and at <= mu * zn:     # zn >= 0: with mu = 0, (zn < 0, 0) is outside
         return zn, zt
     if mu * at <= -zn:
         return 0.0, 0.0

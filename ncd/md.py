@@ -29,8 +29,8 @@ the run and is reported with its step, never as inf/NaN values.
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
+from ._cache import njit
 from .contacts import detect_contacts
 from .model import InputError
 

@@ -20,8 +20,8 @@ from dataclasses import dataclass, asdict
 
 import numpy as np
 import scipy.sparse as sp
-from numba import njit
 
+from ._cache import njit
 from .contacts import delassus_blocks, local_velocity
 from .local_solver import natural_map_sq, solve_single_contact
 

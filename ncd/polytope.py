@@ -15,8 +15,9 @@ clouds are compared).  Nothing here knows about discs: it takes ``H, F, mu``.
 """
 import numpy as np
 import scipy.sparse as sp
-from numba import njit
 from scipy.optimize import linprog
+
+from ._cache import njit
 
 _HIGHS = {"primal_feasibility_tolerance": 1e-10, "dual_feasibility_tolerance": 1e-10}
 

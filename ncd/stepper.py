@@ -19,8 +19,8 @@ goes non-finite or faster than ``speed_limit`` raises :class:`SimulationError`.
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
+from ._cache import njit
 from .contacts import delassus_blocks, detect_contacts, local_velocity, match_warm
 from .model import InputError, SimulationError
 from .nlgs import SolverSettings, restitution_bias, solve_discs

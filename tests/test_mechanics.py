@@ -542,3 +542,27 @@ def test_random_review_order(settled_heap):
     # the heap is hyperstatic: different orders reach different equilibrium forces
     spread = max(np.abs(lim - limits[0]).max() for lim in limits[1:])
     assert spread > 1e-2 * np.abs(limits[0]).max()
+
+
+@pytest.mark.parametrize("mu", [0.0, 0.3])
+def test_a_separating_contact_with_zero_impulse_has_zero_natural_map(mu):
+    """r = 0 with U_n > 0, U_t = 0 solves the contact law: the natural map vanishes.
+    (With mu = 0 the projection once returned (z_n < 0, 0) itself, so a frictionless
+    separating contact read as unsolved and NLGS ran to max_sweeps.)"""
+    from ncd.local_solver import natural_map_sq
+    assert ncd.project_cone(-1.0, 0.0, mu) == (0.0, 0.0)
+    assert ncd.project_cone(2.0, 0.0, mu) == (2.0, 0.0)
+    assert natural_map_sq(0.0, 0.0, 1e-8, 0.0, mu, 0.5) == 0.0
+    # an approaching one does not solve it
+    assert natural_map_sq(0.0, 0.0, -1e-8, 0.0, mu, 0.5) == pytest.approx((0.5e-8) ** 2)
+
+
+def test_frictionless_chain_steps_converge_after_the_impact():
+    """Newton's cradle with e = 1 (mu = 0): after the multi-contact impact the discs
+    separate at rounding-level speeds; every step must be reported converged."""
+    from ncd.studies import scenes
+    s = scenes.chain(5, 1.0, e=1.0)
+    settings = ncd.SolverSettings(tol=1e-8, max_sweeps=2000)
+    reports = [ncd.step(s, 1e-3, settings=settings) for _ in range(30)]
+    assert all(r.converged for r in reports), [(r.sweeps, r.residual) for r in reports]
+    assert max(r.sweeps for r in reports) < 2000

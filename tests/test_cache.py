@@ -1,0 +1,45 @@
+"""numba's cache follows every source of ncd (ncd/_cache.py).
+
+numba keys a cached kernel on its own file: without the digest-named cache
+directory, an edit of ``local_solver.py`` would leave the NLGS sweep of
+``nlgs.py`` (which inlines it) running the old machine code."""
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+
+PROBE = """
+import numpy as np, ncd
+from ncd._cache import cache_dir
+W = np.diag([2.0, 3.0])
+print(cache_dir())
+print(ncd.solve_local(W, [-1.0, 0.5], 1.0).impulse.ravel().tolist())   # sticks
+"""
+
+
+def probe(pkg_parent):
+    env = dict(os.environ, PYTHONPATH=str(pkg_parent), NUMBA_NUM_THREADS="1")
+    env.pop("NUMBA_CACHE_DIR", None)
+    out = subprocess.run([sys.executable, "-c", PROBE], check=True, capture_output=True, text=True,
+                         env=env, cwd=pkg_parent).stdout.split("\n")
+    return out[0], out[1]
+
+
+def test_an_edit_of_a_callee_module_reaches_the_cached_kernels(tmp_path):
+    shutil.copytree(ROOT / "ncd", tmp_path / "ncd", ignore=shutil.ignore_patterns("__pycache__"))
+    first_dir, first = probe(tmp_path)
+    assert Path(first_dir).is_relative_to(tmp_path / "ncd" / "__pycache__")
+    assert any(Path(first_dir).rglob("nlgs._iterate_local*.nbi"))        # the kernels were cached
+    assert probe(tmp_path) == (first_dir, first)                         # and are reused
+    # change the single-contact law inside local_solver.py only: the cached NLGS kernel
+    # of nlgs.py must see it (here: every normal impulse doubled)
+    solver = tmp_path / "ncd" / "local_solver.py"
+    text = solver.read_text()
+    assert text.count("return rn, rt, STICK") == 1
+    solver.write_text(text.replace("return rn, rt, STICK", "return 2.0 * rn, rt, STICK"))
+    second_dir, second = probe(tmp_path)
+    assert second_dir != first_dir
+    assert eval(second)[0] == 2.0 * eval(first)[0] != 0.0
