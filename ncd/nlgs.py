@@ -175,6 +175,7 @@ def _add_impulse(pair, coef, body, c, dn, dt):
 
 @njit(cache=True, nogil=True)
 def _apply_all(pair, coef, body, imp):
+    """``u += M^-1 H s`` for every contact: the initial guess on the free velocities."""
     for c in range(imp.shape[0] // 2):
         _add_impulse(pair, coef, body, c, imp[2 * c], imp[2 * c + 1])
 
@@ -253,6 +254,7 @@ def restitution_bias(contacts, U_initial):
 
 @njit(cache=True)
 def _restitution_bias(e_n, e_t, U_initial):
+    """The loop of :func:`restitution_bias`."""
     bias = np.zeros_like(U_initial)
     for c in range(U_initial.shape[0]):
         if U_initial[c, 0] < 0.0:

@@ -37,10 +37,13 @@ class Progress:
         self.logger, self.total, self.label, self.every = logger, total, label, every
         self.t0 = self.last = time.perf_counter()
         self.last_done = -1                 # the last count logged: the end is logged once
+        self.last_total = total
 
     def __call__(self, done, total=None, extra=""):
         total = self.total if total is None else total
         now = time.perf_counter()
+        if total != self.last_total:        # a new phase with its own total
+            self.last_total, self.last_done = total, -1
         if (now - self.last < self.every and done < total) or self.last_done >= total:
             return
         self.last, self.last_done = now, done

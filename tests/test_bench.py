@@ -29,13 +29,13 @@ def test_dense_packing_has_about_three_contacts_per_disc(packing):
 
 @pytest.mark.skipif(shutil.which("gcc") is None and shutil.which("cc") is None, reason="no C compiler")
 def test_the_c_reference_runs_the_same_loop(packing, tmp_path):
-    """Same packed arrays, same operations in the same order: the same impulses."""
+    """Same packed arrays, same operations in the same order: the same impulses, bit for bit."""
     scene, problem = packing
     t_numba, imp = bench.nlgs_sweep_cost(scene, problem, 7, 1)
-    t_c, c_sum = bench.c_sweep_cost(scene, problem, 7, tmp_path)
+    t_c, imp_c = bench.c_sweep_cost(scene, problem, 7, tmp_path)
     assert t_numba > 0 and t_c > 0
-    assert c_sum == pytest.approx(imp.sum(), rel=1e-12)
     assert imp.sum() > 0
+    np.testing.assert_array_equal(imp_c, imp)
 
 
 def test_threads_give_the_same_ensemble_bit_for_bit(packing):
@@ -108,7 +108,7 @@ def test_bench_core_data(bench_results):
     assert (core.ns_per_update > 0).all() and np.isfinite(core.ns_per_update).all()
     if np.isfinite(core.ns_per_update_c).all():
         assert (core.c_agrees == 1).all()
-    assert (core.prepare_s >= core.detect_s).all()
+    assert (core.detect_s > 0).all() and (core.step_s > core.prepare_s).all()
     assert core.attrs["startup_import_s"] > 0 and "git_commit" in core.attrs
 
 
@@ -116,7 +116,7 @@ def test_bench_ensemble_is_identical_on_every_thread_count(bench_results):
     ens = bench_results["ensemble"]
     assert (ens["same_results"] == 1).all()
     assert len(set(ens.digest.values)) == 1
-    assert ens.speedup.sel(threads=1) == 1.0
+    assert ens.attrs["converged"] == ens.attrs["runs"]
 
 
 def test_bench_rules_cover_every_figure(bench_results):

@@ -131,15 +131,18 @@ def test_changing_a_scene_parameter_reruns_that_scene_only(dag_repo, tmp_path, f
     assert all(r.startswith(figure) or r in ("render_html", "all") for r in jobs), jobs
 
 
-def test_an_ensemble_does_not_depend_on_shards_or_jobs(dag_repo, tmp_path):
-    """fig1's merged ensemble rebuilt elsewhere with 3 shards at -j1 holds the same
-    numbers as the DAG's (2 shards, -j2); only the measured wall times may differ."""
-    overlay = write_overlay(tmp_path, {"fig1_wedged": {"ensemble": {"shards": 3}}})
+def test_an_ensemble_does_not_depend_on_shards_threads_or_jobs(dag_repo, tmp_path):
+    """fig3's merged ensemble rebuilt elsewhere with 3 shards per mode at -j1 (one thread
+    per shard) holds the same numbers as the DAG's (2 shards, -j2: two threads per
+    shard); only the measured wall times may differ."""
+    overlay = write_overlay(tmp_path, {"fig3_equilibrium": {"modes": {"zero": {"shards": 3},
+                                                                      "random": {"shards": 3}}}})
     work = tmp_path / "work"
-    run_snakemake(dag_repo, "-j1", "results/fig1_wedged/ensemble.nc", extra_configs=[overlay], workdir=work)
-    ref = xr.load_dataset(dag_repo / "results" / "fig1_wedged" / "ensemble.nc")
-    new = xr.load_dataset(work / "results" / "fig1_wedged" / "ensemble.nc")
-    assert len(list((work / "results" / "fig1_wedged" / "shards").glob("ensemble_*-of-3.nc"))) == 3
+    run_snakemake(dag_repo, "-j1", "results/fig3_equilibrium/ensemble.nc", extra_configs=[overlay], workdir=work)
+    ref = xr.load_dataset(dag_repo / "results" / "fig3_equilibrium" / "ensemble.nc")
+    new = xr.load_dataset(work / "results" / "fig3_equilibrium" / "ensemble.nc")
+    assert len(list((work / "results" / "fig3_equilibrium" / "shards").glob("*_*-of-3.nc"))) == 6
+    assert ref.sizes["run"] > 100
     timing = [v for v in ref.data_vars if "wall_time" in v]
     xr.testing.assert_identical(ref.drop_vars(timing).drop_attrs(), new.drop_vars(timing).drop_attrs())
 

@@ -198,7 +198,8 @@ def run_ensemble(state, cfg, mode, shard, n_shards, progress=None):
     ds["mode"].attrs.update(flag_values=np.arange(len(MODES), dtype=np.int8), flag_meanings=" ".join(MODES),
                             description="exploration mode of the run")
     ds["max_velocity"].attrs["description"] = "max |u_f| (translation and r * spin) / (|g| h)"
-    ds["wall_time"].attrs["description"] = "seconds of the NLGS run (a measurement, not reproducible)"
+    ds["wall_time"].attrs["description"] = ("seconds of the NLGS run, measured while the rule's other threads "
+                                            "ran other members (a measurement, not reproducible)")
     return ds
 
 

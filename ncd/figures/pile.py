@@ -370,5 +370,6 @@ def ensemble_shard(cfg, construction, cuts, members, tolerances, root_seed, log=
                                      moving_tol=e["moving_tol"], init="zero", review="random"))
     ds["max_velocity"].attrs["units"] = "g h (largest |u_f| or |r w_f| over grains; 0 at equilibrium)"
     ds["unbalanced_fy"].attrs["note"] = "sum of m u_f,y / h: ground_fy - weight equals it exactly"
-    ds["wall_time"].attrs["note"] = "measured seconds per run (the only non-reproducible variable)"
+    ds["wall_time"].attrs["note"] = ("measured seconds per run, while the rule's other threads ran other members "
+                                     "(the only non-reproducible variable)")
     return ds

@@ -342,6 +342,7 @@ def run_ensemble(traj, cfg, members, progress=None):
     )
     ds["status"].attrs["description"] = "final status per contact: 0 no contact, 1 stick, 2/3 slide, 4 fallback"
     ds["sweeps"].attrs["description"] = "cumulative sweeps of the run when it reached this tolerance"
-    ds["wall_time"].attrs["description"] = "cumulative wall time (s) of the run at this tolerance (a measurement)"
+    ds["wall_time"].attrs["description"] = ("cumulative wall time (s) of the run at this tolerance, measured while "
+                                            "the rule's other threads ran other members (a measurement)")
     return ds
 

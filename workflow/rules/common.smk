@@ -93,9 +93,9 @@ rule thumbnail:
     output:
         "docs/thumbnails/{figure}.png",
     log:
-        "results/logs/{figure}/thumbnail.log",
+        "results/logs/thumbnails/{figure}.log",
     benchmark:
-        "results/benchmarks/{figure}/thumbnail.tsv"
+        "results/benchmarks/thumbnails/{figure}.tsv"
     script:
         "../scripts/thumbnail.py"
 
