@@ -104,7 +104,8 @@ def pack_problem(body_a, body_b, normal, arm_a, arm_b, W, mu, bias, inv_mass, in
     """Flat arrays ``(pair, coef, body)`` of the disc-form problem (layout above).
 
     ``coef`` stores ``1/m`` and ``r/I`` per contact side (0 for a wall), so an
-    update needs no body property; the arithmetic is that of ``M^-1 H s``.
+    update needs no body property; the arithmetic is that of ``M^-1 H s``.  A
+    ``W`` with a non-zero off-diagonal entry is refused (it is not a disc contact's).
     """
     n = body_a.shape[0]
     nd = vel.shape[0]
@@ -124,6 +125,9 @@ def pack_problem(body_a, body_b, normal, arm_a, arm_b, W, mu, bias, inv_mass, in
         coef[c, C_NY] = normal[c, 1]
         coef[c, C_RA] = arm_a[c]
         coef[c, C_RB] = arm_b[c]
+        if W[c, 0, 1] != 0.0 or W[c, 1, 0] != 0.0:
+            raise ValueError("disc contacts have diagonal Delassus blocks: W[:, 0, 1] and W[:, 1, 0] "
+                             "must be 0 (use solve_local for a general W)")
         coef[c, C_WNN] = W[c, 0, 0]
         coef[c, C_WTT] = W[c, 1, 1]
         coef[c, C_MU] = mu[c]
@@ -281,9 +285,6 @@ def solve_discs(scene, contacts, vel, spin, guess=None, review_order=None,
     bias = np.zeros((n, 2)) if bias is None else bias
     c = contacts
     W = delassus_blocks(c.body_a, c.body_b, c.arm_a, c.arm_b, scene.inv_mass, scene.inv_inertia) if W is None else W
-    if np.any(W[:, 0, 1] != 0.0) or np.any(W[:, 1, 0] != 0.0):
-        raise ValueError("disc contacts have diagonal Delassus blocks: W[:, 0, 1] and W[:, 1, 0] must be 0 "
-                         "(use solve_local for a general W)")
     q_free = local_velocity(c.body_a, c.body_b, c.normal, c.arm_a, c.arm_b, vel, spin, np.empty((n, 2))) + bias
     pair, coef, body = pack_problem(c.body_a, c.body_b, c.normal, c.arm_a, c.arm_b, W, c.mu, bias,
                                     scene.inv_mass, scene.inv_inertia, vel, spin)

@@ -566,3 +566,16 @@ def test_frictionless_chain_steps_converge_after_the_impact():
     reports = [ncd.step(s, 1e-3, settings=settings) for _ in range(30)]
     assert all(r.converged for r in reports), [(r.sweeps, r.residual) for r in reports]
     assert max(r.sweeps for r in reports) < 2000
+
+
+def test_the_disc_form_refuses_a_non_diagonal_delassus_block():
+    """The packed sweep drops W_nt and W_tn (zero for discs); a W that has them is refused."""
+    scene = ncd.make_scene([[0.0, 0.1]], radius=0.1, density=1.0, walls=[((0.0, 0.0), (0.0, 1.0))])
+    problem = ncd.prepare_step(scene, 1e-3)
+    W = problem.W.copy()
+    W[0, 0, 1] = W[0, 1, 0] = 0.1 * W[0, 0, 0]
+    with pytest.raises(ValueError, match="diagonal Delassus"):
+        ncd.solve_discs(scene, problem.contacts, problem.free_vel.copy(), problem.free_spin.copy(), W=W)
+    result = ncd.solve_discs(scene, problem.contacts, problem.free_vel.copy(), problem.free_spin.copy(),
+                             W=problem.W)
+    assert result.converged and result.impulse[0, 0] > 0

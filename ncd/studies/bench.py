@@ -68,11 +68,6 @@ def best_of(fn, repeat):
     return min(times)
 
 
-def fixed_sweeps(sweeps):
-    """Settings that run exactly ``sweeps`` sweeps (residual evaluated once, at the end)."""
-    return SolverSettings(tol=1e-300, max_sweeps=sweeps, check_every=sweeps)
-
-
 def _status_bytes(field):
     for line in Path("/proc/self/status").read_text().splitlines():
         if line.startswith(field + ":"):
