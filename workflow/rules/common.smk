@@ -11,14 +11,19 @@
 import glob
 from pathlib import Path
 
-from snakemake.utils import validate
+from ncd.configcheck import check_config
 
 ROOT = Path(workflow.basedir)
 
 # Figures in the order of the paper; each has a rules file and a config section.
 FIGURES = [f for f in ("fig1_wedged", "fig2_slope", "fig3_equilibrium", "fig4_pile",
                        "stability", "error_vs_runtime")
-           if (ROOT / "workflow" / "rules" / f"{f}.smk").exists() and f in config]
+           if (ROOT / "workflow" / "rules" / f"{f}.smk").exists()]
+
+# Every config section (a missing figure section included) is checked here, before any
+# job: its schema (integers that are integers), finite numbers everywhere, and the
+# cross-field constraints of ncd/configcheck.py; errors name section and key.
+check_config(config, FIGURES, ROOT / "workflow" / "schemas")
 
 # Threads of an ensemble rule: its NLGS runs are spread over them (ncd.explore.run_parallel,
 # results identical whatever the count); Snakemake lowers it to the cores it was given.
@@ -46,9 +51,19 @@ def ncd_sources(figure):
 
 
 def section(figure):
-    """The validated config section of a figure (validated once, on first use)."""
-    validate(config[figure], str(ROOT / "workflow" / "schemas" / f"{figure}.schema.yaml"))
+    """The config section of a figure (checked with every other by check_config above)."""
     return config[figure]
+
+
+def without_shards(cfg):
+    """A plain copy of a config (sub)section without any ``shards`` key: the ``params``
+    of every rule but the merges, so that a new shard count reruns only the ensemble's
+    explore and merge rules (and what reads the merged file), and stays out of provenance."""
+    if isinstance(cfg, dict):
+        return {k: without_shards(v) for k, v in cfg.items() if k != "shards"}
+    if isinstance(cfg, (list, tuple)):
+        return [without_shards(v) for v in cfg]
+    return cfg
 
 
 def shard_files(figure, name, n_shards):

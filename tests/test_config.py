@@ -1,0 +1,130 @@
+"""Config checks before any job (issue 14, items 2 and 6): the ten malformed configs
+that passed the JSON schemas, errors naming section and key, a missing section."""
+import copy
+import math
+
+import pytest
+import yaml
+
+from conftest import ROOT, copy_workflow, run_snakemake
+from ncd import InputError
+from ncd.configcheck import ConfigError, check_config
+
+SCHEMAS = ROOT / "workflow" / "schemas"
+CONFIG = yaml.safe_load((ROOT / "config.yaml").read_text())
+REDUCED = yaml.safe_load((ROOT / "tests" / "config_reduced.yaml").read_text())
+RULE_FILES = [f for f in CONFIG if (ROOT / "workflow" / "rules" / f"{f}.smk").exists() and f != "bench"]
+
+
+def merged(base, overlay):
+    """``overlay`` merged into a copy of ``base`` (mappings recursively, as Snakemake does)."""
+    out = copy.deepcopy(base)
+    for k, v in overlay.items():
+        out[k] = merged(out[k], v) if isinstance(v, dict) and isinstance(out.get(k), dict) else v
+    return out
+
+
+def errors_of(overlay_yaml, drop=()):
+    cfg = merged(CONFIG, yaml.safe_load(overlay_yaml) or {})
+    for section in drop:
+        cfg.pop(section)
+    with pytest.raises(ConfigError) as info:
+        check_config(cfg, RULE_FILES, SCHEMAS)
+    return str(info.value)
+
+
+def test_the_shipped_configs_pass():
+    check_config(CONFIG, RULE_FILES, SCHEMAS)
+    check_config(merged(CONFIG, REDUCED), RULE_FILES, SCHEMAS)
+    assert issubclass(ConfigError, InputError) and issubclass(ConfigError, ValueError)
+
+
+# the ten configs of issue 14 that planned jobs, with the text the error must hold
+SLIPPED = [
+    ("fig1_wedged: {mu: .nan}", "fig1_wedged.mu = nan"),
+    ("fig1_wedged: {mu: .inf}", "fig1_wedged.mu = inf"),
+    ("fig1_wedged: {h: .nan}", "fig1_wedged.h = nan"),
+    ("fig1_wedged: {beta_deg: .nan}", "fig1_wedged.beta_deg = nan"),
+    ("fig1_wedged: {ensemble: {runs: 8, shards: 9}}", "fig1_wedged.ensemble.shards = 9 must be <= "
+                                                      "fig1_wedged.ensemble.runs = 8"),
+    ("fig3_equilibrium: {modes: {warm: {runs: 3, shards: 4}}}", "fig3_equilibrium.modes.warm.shards = 4"),
+    ("fig1_wedged: {ensemble: {force_min: 200.0, force_max: 100.0}}",
+     "fig1_wedged.ensemble.force_min = 200.0 must be < fig1_wedged.ensemble.force_max = 100.0"),
+    ("fig1_wedged: {sweep: {gamma_min_deg: 45.0, gamma_max_deg: 1.0}}",
+     "fig1_wedged.sweep.gamma_min_deg = 45.0 must be < fig1_wedged.sweep.gamma_max_deg = 1.0"),
+    ("fig1_wedged: {ensemble: {runs: 2000.0}}", "fig1_wedged.ensemble.runs = 2000.0: 2000.0 is not of type 'integer'"),
+    (None, "config section 'fig1_wedged' is missing"),
+]
+
+
+@pytest.mark.parametrize("overlay, message", SLIPPED)
+def test_a_config_that_slipped_through_is_refused_naming_the_key(overlay, message):
+    text = errors_of(overlay or "", drop=() if overlay else ("fig1_wedged",))
+    assert message in text, text
+    assert text.count("\n") == 1, text          # one error, reported once
+
+
+@pytest.mark.parametrize("overlay, message", [
+    ("fig3_equilibrium: {packing: {gravity: [0.0, -.inf]}}", "fig3_equilibrium.packing.gravity.1 = -inf"),
+    ("fig4_pile: {ensemble: {tol: .nan}}", "fig4_pile.ensemble.tol = nan"),
+    ("bench: {core: {step_tol: .nan}}", "bench.core.step_tol = nan"),
+    ("fig4_pile: {grains: {radius_min: 2.0e-3}}", "fig4_pile.grains.radius_min = 0.002 must be <= "),
+    ("fig4_pile: {surface: {fit_range: [0.8, 0.2]}}", "fig4_pile.surface.fit_range = [0.8, 0.2]"),
+    ("fig4_pile: {tolerance_study: {runs: 600}}", "fig4_pile.tolerance_study.runs = 600 must be <= "
+                                                  "fig4_pile.ensemble.runs = 500"),
+    ("fig2_slope: {flow: {step: 101}}", "fig2_slope.flow.step = 101 must be <= fig2_slope.flow.n_steps = 100"),
+    ("fig3_equilibrium: {modes: {zero: {runs: 1.0e+4}}}", "fig3_equilibrium.modes.zero.runs = 10000.0"),
+    ("fig3_equilibrium: {solver: {max_sweeps: 20000.5}}", "fig3_equilibrium.solver.max_sweeps = 20000.5"),
+])
+def test_nonfinite_cross_field_and_integer_checks_everywhere(overlay, message):
+    text = errors_of(overlay)
+    assert message in text, text
+
+
+def test_a_radius_range_may_be_degenerate_but_a_force_range_may_not():
+    check_config(merged(CONFIG, {"fig4_pile": {"grains": {"radius_min": 1e-3, "radius_max": 1e-3}}}),
+                 RULE_FILES, SCHEMAS)
+    assert "force_min = 5.0 must be < " in errors_of("fig1_wedged: {ensemble: {force_min: 5.0, force_max: 5.0}}")
+
+
+@pytest.mark.parametrize("section", [s for s in RULE_FILES if "tol" in CONFIG[s].get("solver", {})])
+def test_a_schema_error_names_the_section(section):
+    """``solver.tol`` exists in several sections: the message says which."""
+    text = errors_of(f"{section}: {{solver: {{tol: 0}}}}")
+    assert f"{section}.solver.tol = 0" in text and "exclusiveMinimum" in text, text
+
+
+def test_every_error_is_reported_at_once():
+    text = errors_of("fig1_wedged: {mu: .nan, ensemble: {runs: 2.5}}\nfig4_pile: {h: -1}")
+    assert all(s in text for s in ("fig1_wedged.mu = nan", "fig1_wedged.ensemble.runs = 2.5", "fig4_pile.h = -1"))
+    assert not math.isnan(CONFIG["fig1_wedged"]["mu"])      # the shipped config is untouched
+
+
+@pytest.fixture()
+def fresh_repo(tmp_path):
+    return copy_workflow(tmp_path / "repo")
+
+
+def test_snakemake_stops_before_any_job_naming_the_key(fresh_repo, tmp_path):
+    overlay = tmp_path / "overlay.yaml"
+    overlay.write_text("fig1_wedged: {mu: .nan}\n")
+    proc = run_snakemake(fresh_repo, "-n", extra_configs=[overlay], check=False)
+    out = proc.stdout + proc.stderr
+    assert proc.returncode != 0 and "fig1_wedged.mu = nan: not a finite number" in out, out[-3000:]
+    assert "Job stats" not in out and not (fresh_repo / "results").exists()
+
+
+def test_a_removed_figure_section_stops_the_run(fresh_repo):
+    """``all`` used to plan without the figure; now the run stops naming the section."""
+    config = fresh_repo / "config.yaml"
+    data = yaml.safe_load(config.read_text())
+    del data["fig1_wedged"]
+    config.write_text(yaml.safe_dump(data))
+    reduced = fresh_repo / "tests" / "config_reduced.yaml"
+    data = yaml.safe_load(reduced.read_text())
+    data.pop("fig1_wedged", None)
+    reduced.write_text(yaml.safe_dump(data))
+    proc = run_snakemake(fresh_repo, "-n", check=False)
+    out = proc.stdout + proc.stderr
+    assert proc.returncode != 0 and "config section 'fig1_wedged' is missing" in out, out[-3000:]
+    assert "Job stats" not in out
