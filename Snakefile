@@ -1,6 +1,7 @@
 # ncd: reproduce the figures of Moreau (2005), "Indetermination in the numerical
 # simulation of granular systems".  `snakemake -j2` builds every figure;
 # `snakemake -j2 fig1_wedged` builds one figure and only its inputs.
+import sys
 from pathlib import Path
 
 from snakemake.utils import min_version, validate
@@ -12,6 +13,14 @@ configfile: str(Path(workflow.basedir) / "config.yaml")
 validate(config, str(Path(workflow.basedir) / "workflow/schemas/config.schema.yaml"))
 
 include: "workflow/rules/common.smk"
+
+# A run killed with SIGKILL leaves its locks: remove them (and stray *.part files) when no
+# Snakemake process or job still runs here, so that a plain rerun needs no --unlock; its
+# unfinished jobs are rerun by profiles/default (rerun-incomplete).  See ncd.pipeline.
+if workflow.is_main_process and not workflow.dryrun:
+    from ncd.pipeline import recover_killed_run
+
+    recover_killed_run(".", logger=lambda m: print(m, file=sys.stderr))
 
 for _figure in FIGURES:
     include: f"workflow/rules/{_figure}.smk"

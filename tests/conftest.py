@@ -15,7 +15,8 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
-WORKFLOW_FILES = ("Snakefile", "config.yaml", "workflow", "notebooks", "ncd", "tests/config_reduced.yaml")
+WORKFLOW_FILES = ("Snakefile", "config.yaml", "profiles", "workflow", "notebooks", "ncd",
+                  "tests/config_reduced.yaml")
 
 
 def copy_workflow(dst):

@@ -2,6 +2,9 @@
 import json
 import os
 import re
+import signal
+import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -215,3 +218,136 @@ def test_editing_a_figure_module_reruns_that_figure_only(dag_repo, figure):
     if figure == ALL_FIGURES[0]:
         core = plan_after_touching("nlgs.py")
         assert {f"{f}_notebook" for f in ALL_FIGURES} <= set(core), core
+
+
+# --- shards, provenance, logs, interrupted runs (issue 14, items 6 and 7) ---------------
+
+SHARDED = {"fig1_wedged": ("ensemble",), "fig2_slope": ("explore",), "fig3_equilibrium": ("modes", "zero"),
+           "fig4_pile": ("ensemble",)}
+
+
+@pytest.mark.parametrize("figure", [f for f in SHARDED if f in CONFIG])
+def test_changing_only_shards_reruns_only_the_ensemble(dag_repo, tmp_path, figure):
+    """A new shard count plans the figure's explore and merge jobs and what reads the
+    merged file (analysis, notebook), never its simulation, projections or cuts."""
+    overlay = write_overlay(tmp_path, {figure: nested(SHARDED[figure], {"shards": 3})})
+    jobs = planned_jobs(run_snakemake(dag_repo, "-n", extra_configs=[overlay]))
+    assert jobs.get(f"{figure}_explore", 0) >= 3 and f"{figure}_merge" in jobs, jobs
+    allowed = {f"{figure}_{r}" for r in ("explore", "merge", "analyse", "notebook")} | {"render_html", "all"}
+    assert set(jobs) <= allowed, jobs
+
+
+def test_an_ensemble_is_identical_with_its_attributes_whatever_the_shard_count(dag_repo, tmp_path):
+    """fig3 and fig1 rebuilt with 3 shards: same data and same attributes (no shard
+    count in the provenance), only the measured wall times differ."""
+    overlay = write_overlay(tmp_path, {"fig3_equilibrium": {"modes": {"zero": {"shards": 3}}},
+                                       "fig1_wedged": {"ensemble": {"shards": 3}}})
+    work = tmp_path / "work"
+    targets = ["results/fig3_equilibrium/ensemble.nc", "results/fig1_wedged/ensemble.nc"]
+    run_snakemake(dag_repo, "-j2", *targets, extra_configs=[overlay], workdir=work)
+    for target in targets:
+        ref, new = xr.load_dataset(dag_repo / target), xr.load_dataset(work / target)
+        assert "shards" not in ref.attrs["config_yaml"] and ref.attrs == new.attrs, target
+        timing = [v for v in ref.data_vars if "wall_time" in v]
+        xr.testing.assert_identical(ref.drop_vars(timing), new.drop_vars(timing))
+
+
+def test_a_failing_job_writes_its_traceback_to_its_log(tmp_path):
+    """An uncaught exception of a script reaches its ``log:`` file, not only the console."""
+    (tmp_path / "fail.py").write_text(
+        "from ncd.pipeline import start\n"
+        "log = start(snakemake)\n"
+        "log.info('about to fail')\n"
+        "def deep(x):\n    raise ValueError(f'no such member: {x}')\n"
+        "deep(42)\n")
+    (tmp_path / "Snakefile").write_text(
+        'rule fail:\n    output: "out.nc"\n    log: "logs/fail.log"\n    script: "fail.py"\n')
+    proc = subprocess.run([sys.executable, "-m", "snakemake", "-s", str(tmp_path / "Snakefile"), "-d", str(tmp_path),
+                           "-j1", "--workflow-profile", "none"], capture_output=True, text=True)
+    assert proc.returncode != 0
+    log = (tmp_path / "logs" / "fail.log").read_text()
+    assert "about to fail" in log and "Traceback (most recent call last)" in log, log
+    assert "in deep" in log and "ValueError: no such member: 42" in log, log
+    assert not (tmp_path / "out.nc").exists()
+
+
+def test_sigterm_of_a_job_is_logged_and_runs_its_cleanup(tmp_path):
+    """A job terminated by SIGTERM (Snakemake cancelling it) exits 143 through ``finally``."""
+    code = ("import time, types\nfrom ncd.pipeline import start\n"
+            f"log = start(types.SimpleNamespace(threads=1, rule='demo', log=[{str(tmp_path / 'j.log')!r}]))\n"
+            "try:\n    print('ready', flush=True)\n    time.sleep(60)\n"
+            f"finally:\n    open({str(tmp_path / 'cleaned')!r}, 'w').close()\n")
+    proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True)
+    assert proc.stdout.readline().strip() == "ready"
+    proc.send_signal(signal.SIGTERM)
+    assert proc.wait(timeout=30) == 143
+    assert (tmp_path / "cleaned").exists()
+    assert "terminated by signal 15" in (tmp_path / "j.log").read_text()
+
+
+def start_snakemake(repo, workdir, *args):
+    """``snakemake`` on ``repo``'s workflow in ``workdir`` (reduced config), in a new
+    process group, its console to ``workdir/console.txt``."""
+    workdir.mkdir(parents=True, exist_ok=True)
+    cmd = [sys.executable, "-m", "snakemake", "-s", str(repo / "Snakefile"), "-d", str(workdir), *args,
+           "--configfile", str(repo / "config.yaml"), str(repo / "tests" / "config_reduced.yaml")]
+    console = open(workdir / "console.txt", "w")
+    return subprocess.Popen(cmd, stdout=console, stderr=subprocess.STDOUT, start_new_session=True)
+
+
+def wait_for(predicate, timeout, what):
+    t0 = time.monotonic()
+    while not predicate():
+        assert time.monotonic() - t0 < timeout, f"timed out waiting for {what}"
+        time.sleep(0.2)
+
+
+@pytest.mark.parametrize("how", ["SIGKILL snakemake", "SIGKILL group", "SIGTERM snakemake"])
+def test_an_interrupted_run_reruns_without_flags_and_gives_the_same_file(dag_repo, tmp_path, how):
+    """Kill Snakemake in the middle of an ensemble job (fig1 shard 0), then a plain rerun:
+    no --unlock, no --rerun-incomplete; no half-written output at any time; the
+    interrupted job is redone and the merged file equals the uninterrupted run's."""
+    from ncd.pipeline import _snakemake_processes
+
+    work = tmp_path / "work"
+    target = "results/fig1_wedged/ensemble.nc"
+    shard_log = work / "results/logs/fig1_wedged/explore_ensemble_0-of-2.log"
+    proc = start_snakemake(dag_repo, work, "-j1", target)
+    shard = work / "results/fig1_wedged/shards/ensemble_0-of-2.nc"
+    wait_for(lambda: shard_log.exists() and "rule fig1_wedged_explore" in shard_log.read_text(), 600,
+             "shard 0 to start")
+    assert not shard.exists()                       # its job runs (a shard takes seconds): kill now
+    if how == "SIGKILL group":                      # Snakemake and its jobs (a lost node, kill -9 of the session)
+        os.killpg(proc.pid, signal.SIGKILL)
+    else:                                           # Snakemake only: its job runs on, orphaned, or is cancelled
+        proc.send_signal(getattr(signal, how.split()[0]))
+    proc.wait(timeout=120)
+    wait_for(lambda: not _snakemake_processes(work), 600, "orphaned jobs to end")
+    console = (work / "console.txt").read_text()
+    assert not (work / target).exists(), console[-3000:]
+    for path in (work / "results").rglob("*.nc"):   # whatever was written is whole
+        with xr.open_dataset(path) as ds:
+            assert ds.sizes["run"] == 210, path
+    if how != "SIGTERM snakemake":
+        assert list((work / ".snakemake" / "locks").glob("*")), "a killed run leaves its locks"
+
+    if how == "SIGTERM snakemake":                  # Snakemake lets its running job finish, starts no other
+        assert "Will exit after finishing currently running jobs" in console, console[-3000:]
+        assert shard.exists() and not (work / "results/fig1_wedged/shards/ensemble_1-of-2.nc").exists()
+    else:                                           # killed within shard 0's job
+        assert "Finished jobid" not in console, console[-3000:]
+        assert shard.exists() == (how == "SIGKILL snakemake")       # its orphan finished it
+        finished_by_orphan = shard.exists()
+    rerun = run_snakemake(dag_repo, "-j1", target, workdir=work)
+    out = rerun.stdout + rerun.stderr
+    redone = re.search(r"output: results/fig1_wedged/shards/ensemble_0-of-2.nc\n.*?reason: ([^\n]*)", out, re.S)
+    if how == "SIGTERM snakemake":                  # shard 0 was finished and recorded: kept
+        assert not redone and "ensemble_1-of-2.nc" in out, out[-3000:]
+    else:                                           # the interrupted job was redone: as incomplete when
+        assert redone, out[-3000:]                  # its orphaned process finished the file, else as missing
+        assert redone.group(1).startswith("Forced execution" if finished_by_orphan else "Missing output"), \
+            redone.group(1)
+    assert not list((work / "results").rglob("*.part"))
+    ref, new = xr.load_dataset(dag_repo / target), xr.load_dataset(work / target)
+    timing = [v for v in ref.data_vars if "wall_time" in v]
+    xr.testing.assert_identical(ref.drop_vars(timing), new.drop_vars(timing))

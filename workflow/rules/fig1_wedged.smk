@@ -14,7 +14,7 @@ rule fig1_wedged_explore:
         shard=r"\d+",
         n=r"\d+",
     params:
-        config=CFG,
+        config=without_shards(CFG),
     threads: 1
     log:
         log(FIG, "explore_{name}_{shard}-of-{n}"),
@@ -46,7 +46,7 @@ rule fig1_wedged_simulate:
     output:
         "results/fig1_wedged/evolutions.nc",
     params:
-        config=CFG,
+        config=without_shards(CFG),
     threads: 1
     log:
         log(FIG, "simulate"),
@@ -63,7 +63,7 @@ rule fig1_wedged_sweep:
     output:
         "results/fig1_wedged/sweep.nc",
     params:
-        config=CFG,
+        config=without_shards(CFG),
     threads: 1
     log:
         log(FIG, "sweep"),

@@ -41,7 +41,7 @@ rule fig2_slope_explore:
         n=r"\d+",
     threads: ENSEMBLE_THREADS
     params:
-        config=CFG2_EXP,
+        config=without_shards(CFG2_EXP),
     log:
         log(FIG2, "explore_{shard}-of-{n}"),
     benchmark:
@@ -73,7 +73,7 @@ rule fig2_slope_analyse:
     output:
         f"{F2}/measures.nc",
     params:
-        config=CFG2,
+        config=without_shards(CFG2),
     log:
         log(FIG2, "analyse"),
     benchmark:
@@ -92,7 +92,7 @@ rule fig2_slope_notebook:
         png=f"results/figures/{FIG2}.png",
         pdf=f"results/figures/{FIG2}.pdf",
     params:
-        config=CFG2,
+        config=without_shards(CFG2),
     log:
         notebook=f"results/notebooks/{FIG2}.ipynb",
     benchmark:

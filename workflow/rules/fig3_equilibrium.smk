@@ -18,7 +18,7 @@ rule fig3_equilibrium_simulate:
     output:
         f"{F3}/state.nc",
     params:
-        config=CFG,
+        config=without_shards(CFG),
     log:
         log(FIG, "simulate"),
     benchmark:
@@ -39,7 +39,7 @@ rule fig3_equilibrium_explore:
         n=r"\d+",
     threads: ENSEMBLE_THREADS
     params:
-        config=CFG,
+        config=without_shards(CFG),
     log:
         log(FIG, "explore_{name}_{shard}-of-{n}"),
     benchmark:
@@ -70,7 +70,7 @@ rule fig3_equilibrium_projection:
     output:
         f"{F3}/projection.nc",
     params:
-        config=CFG,
+        config=without_shards(CFG),
     log:
         log(FIG, "projection"),
     benchmark:
@@ -86,7 +86,7 @@ rule fig3_equilibrium_uniform:
     output:
         f"{F3}/uniform.nc",
     params:
-        config=CFG,
+        config=without_shards(CFG),
     log:
         log(FIG, "uniform"),
     benchmark:
@@ -106,7 +106,7 @@ rule fig3_equilibrium_notebook:
         png=f"results/figures/{FIG}.png",
         pdf=f"results/figures/{FIG}.pdf",
     params:
-        config=CFG,
+        config=without_shards(CFG),
     log:
         notebook=f"results/notebooks/{FIG}.ipynb",
     benchmark:

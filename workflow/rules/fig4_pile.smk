@@ -61,7 +61,7 @@ rule fig4_pile_explore:
         n=r"\d+",
     threads: ENSEMBLE_THREADS
     params:
-        config=CFG4_EXP,
+        config=without_shards(CFG4_EXP),
     log:
         log(FIG4, "explore_{name}_{shard}-of-{n}"),
     benchmark:
@@ -98,7 +98,7 @@ rule fig4_pile_notebook:
         png=f"results/figures/{FIG4}.png",
         pdf=f"results/figures/{FIG4}.pdf",
     params:
-        config=CFG4,
+        config=without_shards(CFG4),
     log:
         notebook=f"results/notebooks/{FIG4}.ipynb",
     benchmark:
