@@ -10,7 +10,7 @@ Public API::
     result = ncd.solve_local(W, q, mu)                # a problem in local form
 """
 from .contacts import Contacts, detect_contacts
-from .local_solver import project_cone, solve_single_contact_py
+from .local_solver import project_cone_py as project_cone, solve_single_contact_py
 from .model import InputError, Scene, SimulationError
 from .nlgs import NLGSResult, SolverSettings, solve_discs, solve_local
 from .scene import make_scene

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import checks
 from ._cache import njit
 from .detection import disc_pairs
 
@@ -67,7 +68,7 @@ def detect_contacts(scene, alert=0.0, pos=None):
     from a direct test against each wall.  Contacts are sorted by body-pair key,
     so their order does not depend on the grid.
     """
-    pos = scene.pos if pos is None else pos
+    pos = checks.detection_args(scene, alert, pos)
     nm = scene.n_mobile
     a, b, shift = disc_pairs(pos, scene.radius, nm, alert, scene.period)
     n_walls = len(scene.wall_point)

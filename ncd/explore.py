@@ -18,6 +18,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numba
 import numpy as np
 
+from . import checks
 from .nlgs import SolverSettings
 from .stepper import initial_guess, solve_problem
 
@@ -77,6 +78,8 @@ def explore(scene, problem, members, root_seed, init="zero", review="random", gu
     (:func:`random_guess` with ``guess_scale``); ``review``: "fixed" or "random".
     ``progress(done, total)`` is called now and then; ``threads``: see :func:`run_parallel`.
     """
+    members = checks.explore_args(scene, problem, members, root_seed, init, review, guess_scale,
+                                  settings, progress, threads)
     if init not in INIT_MODES:
         raise ValueError(f"init = {init!r} must be one of {INIT_MODES}")
     if review not in ("fixed", "random"):

@@ -26,6 +26,7 @@ which vanishes exactly at solutions (``rho = 1 / W_nn`` makes it an impulse).
 """
 import numpy as np
 
+from . import checks
 from ._cache import njit
 
 NO_CONTACT, STICK, SLIDE_FORWARD, SLIDE_BACKWARD, FALLBACK = 0, 1, 2, 3, 4
@@ -87,7 +88,13 @@ def natural_map_sq(rn, rt, un, ut, mu, rho):
 
 def solve_single_contact_py(W, q, mu):
     """Convenience wrapper: ``W`` (2, 2), ``q`` (2,) -> (r, status)."""
+    W, q, mu = checks.single_contact(W, q, mu)
     W = np.asarray(W, dtype=float)
     rn, rt, status = solve_single_contact(W[0, 0], W[0, 1], W[1, 0], W[1, 1],
                                           float(q[0]), float(q[1]), float(mu))
     return np.array([rn, rt]), int(status)
+
+
+def project_cone_py(zn, zt, mu):
+    """:func:`project_cone` with its arguments checked: the public ``ncd.project_cone``."""
+    return project_cone(checks.real("zn", zn), checks.real("zt", zt), checks.real("mu", mu, 0.0))

@@ -2,24 +2,8 @@
 import numpy as np
 
 from .contacts import detect_contacts
+from . import checks
 from .model import InputError, Scene
-
-
-def _finite(name, value):
-    arr = np.asarray(value, dtype=float)
-    if not np.all(np.isfinite(arr)):
-        bad = np.argwhere(~np.isfinite(arr))[0]
-        where = ", ".join(str(int(i)) for i in bad)
-        raise InputError(f"{name} must be finite; {name}[{where}] = {arr[tuple(bad)]}")
-    return arr
-
-
-def _in_range(name, value, lo, hi=np.inf, lo_open=False):
-    v = float(value)
-    if not np.isfinite(v) or v < lo or v > hi or (lo_open and v == lo):
-        span = f"({lo}, {hi}]" if lo_open else f"[{lo}, {hi}]"
-        raise InputError(f"{name} = {value!r} is outside {span}")
-    return v
 
 
 def make_scene(pos, radius, density=1.0, *, obstacle_pos=None, obstacle_radius=None,
@@ -34,41 +18,41 @@ def make_scene(pos, radius, density=1.0, *, obstacle_pos=None, obstacle_radius=N
     smaller radius of each pair.  Every violation raises :class:`InputError`
     naming the value.
     """
-    pos = _finite("pos", pos).reshape(-1, 2)
+    pos = checks.array("pos", pos, (None, 2))
     n = len(pos)
     if n == 0:
         raise InputError("a scene needs at least one mobile disc (pos is empty)")
-    radius = _finite("radius", np.broadcast_to(radius, (n,))).copy()
-    if np.any(radius <= 0):
-        i = int(np.argmin(radius))
-        raise InputError(f"radius must be > 0; radius[{i}] = {radius[i]}")
-    density = _finite("density", np.broadcast_to(density, (n,))).copy()
-    if np.any(density <= 0):
-        i = int(np.argmin(density))
-        raise InputError(f"density must be > 0; density[{i}] = {density[i]}")
-    mu = _in_range("mu", mu, 0.0)
-    mu_obstacle = mu if mu_obstacle is None else _in_range("mu_obstacle", mu_obstacle, 0.0)
-    e_n = _in_range("e_n", e_n, 0.0, 1.0)
-    e_t = _in_range("e_t", e_t, 0.0, 1.0)
-    e_n_obstacle = e_n if e_n_obstacle is None else _in_range("e_n_obstacle", e_n_obstacle, 0.0, 1.0)
-    e_t_obstacle = e_t if e_t_obstacle is None else _in_range("e_t_obstacle", e_t_obstacle, 0.0, 1.0)
-    gravity = _finite("gravity", gravity).reshape(2)
+    radius = checks.per_item("radius", radius, n, 0.0, lo_open=True)
+    density = checks.per_item("density", density, n, 0.0, lo_open=True)
+    mu = checks.real("mu", mu, 0.0)
+    mu_obstacle = mu if mu_obstacle is None else checks.real("mu_obstacle", mu_obstacle, 0.0)
+    e_n = checks.real("e_n", e_n, 0.0, 1.0)
+    e_t = checks.real("e_t", e_t, 0.0, 1.0)
+    e_n_obstacle = e_n if e_n_obstacle is None else checks.real("e_n_obstacle", e_n_obstacle, 0.0, 1.0)
+    e_t_obstacle = e_t if e_t_obstacle is None else checks.real("e_t_obstacle", e_t_obstacle, 0.0, 1.0)
+    gravity = checks.array("gravity", gravity, (2,))
+    checks.real("overlap_tolerance", overlap_tolerance, 0.0)
 
-    opos = np.zeros((0, 2)) if obstacle_pos is None else _finite("obstacle_pos", obstacle_pos).reshape(-1, 2)
-    orad = np.zeros(0) if obstacle_radius is None else _finite(
-        "obstacle_radius", np.broadcast_to(obstacle_radius, (len(opos),))).copy()
-    if np.any(orad <= 0):
-        i = int(np.argmin(orad))
-        raise InputError(f"obstacle_radius must be > 0; obstacle_radius[{i}] = {orad[i]}")
-
-    wp = np.array([_finite(f"walls[{k}].point", w[0]) for k, w in enumerate(walls)]).reshape(-1, 2)
-    wn = np.array([_finite(f"walls[{k}].normal", w[1]) for k, w in enumerate(walls)]).reshape(-1, 2)
+    opos = np.zeros((0, 2)) if obstacle_pos is None else checks.array("obstacle_pos", obstacle_pos, (None, 2))
+    if len(opos) and obstacle_radius is None:
+        raise InputError("obstacle_pos is given without obstacle_radius")
+    orad = np.zeros(0) if not len(opos) else checks.per_item("obstacle_radius", obstacle_radius, len(opos),
+                                                             0.0, lo_open=True)
+    try:
+        walls = [tuple(w) for w in walls]
+    except TypeError:
+        raise InputError(f"walls = {walls!r} must be a sequence of (point, normal) pairs") from None
+    for k, w in enumerate(walls):
+        if len(w) != 2:
+            raise InputError(f"walls[{k}] = {w!r} must be a (point, normal) pair")
+    wp = np.array([checks.array(f"walls[{k}].point", w[0], (2,)) for k, w in enumerate(walls)]).reshape(-1, 2)
+    wn = np.array([checks.array(f"walls[{k}].normal", w[1], (2,)) for k, w in enumerate(walls)]).reshape(-1, 2)
     norms = np.linalg.norm(wn, axis=1)
     if np.any(norms == 0):
         raise InputError(f"walls[{int(np.argmin(norms))}].normal is zero")
     wn = wn / norms[:, None] if len(wn) else wn
 
-    period = 0.0 if period is None else _in_range("period", period, 0.0, lo_open=True)
+    period = 0.0 if period is None else checks.real("period", period, 0.0, lo_open=True)
     if period > 0:
         dmax = 2 * max(radius.max(), orad.max() if len(orad) else 0.0)
         if period < 3 * dmax:
@@ -78,7 +62,18 @@ def make_scene(pos, radius, density=1.0, *, obstacle_pos=None, obstacle_radius=N
         opos = opos.copy()
         opos[:, 0] %= period
 
-    mass = density * np.pi * radius ** 2
+    with np.errstate(all="ignore"):
+        mass = density * np.pi * radius ** 2
+        inertia = 0.5 * mass * radius ** 2
+        bad = ~(np.isfinite(mass) & np.isfinite(inertia) & (mass > 0) & (inertia > 0) & np.isfinite(1.0 / inertia))
+    if np.any(bad):
+        i = int(np.argmax(bad))
+        raise InputError(f"disc {i}: mass {mass[i]:.3g} and inertia {inertia[i]:.3g} from density {density[i]} "
+                         f"and radius {radius[i]} must be finite and > 0 (double precision)")
+    extent = np.abs(np.vstack([pos, opos])).max()
+    if extent > 1e150 or (len(wp) and np.abs(wp).max() > 1e150):
+        raise InputError(f"coordinates must be below 1e150 in magnitude (contact geometry squares them); "
+                         f"got {max(extent, np.abs(wp).max() if len(wp) else 0.0):.3g}")
     all_pos = np.vstack([pos, opos])
     all_rad = np.concatenate([radius, orad])
     scene = Scene(
@@ -90,11 +85,11 @@ def make_scene(pos, radius, density=1.0, *, obstacle_pos=None, obstacle_radius=N
         mu=mu, mu_obstacle=mu_obstacle, e_n=e_n, e_t=e_t,
         e_n_obstacle=e_n_obstacle, e_t_obstacle=e_t_obstacle, period=period,
         angle=np.zeros(len(all_rad)) if angle is None else np.concatenate(
-            [_finite("angle", np.broadcast_to(angle, (n,))), np.zeros(len(orad))]),
+            [checks.per_item("angle", angle, n), np.zeros(len(orad))]),
         vel=np.zeros((len(all_rad), 2)) if vel is None else np.vstack(
-            [_finite("vel", vel).reshape(n, 2), np.zeros((len(orad), 2))]),
+            [checks.array("vel", vel, (n, 2)), np.zeros((len(orad), 2))]),
         spin=np.zeros(len(all_rad)) if spin is None else np.concatenate(
-            [_finite("spin", np.broadcast_to(spin, (n,))), np.zeros(len(orad))]),
+            [checks.per_item("spin", spin, n), np.zeros(len(orad))]),
     )
     check_overlaps(scene, overlap_tolerance)
     return scene

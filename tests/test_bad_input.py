@@ -117,13 +117,242 @@ def test_state_going_non_finite_raises_simulation_error():
 
 
 def test_solver_settings_and_local_form_reject():
-    with pytest.raises(ValueError, match=r"tol = -1\.0 must be > 0"):
-        ncd.SolverSettings(tol=-1.0)
-    with pytest.raises(ValueError, match="criterion = 'energy'"):
-        ncd.SolverSettings(criterion="energy")
-    with pytest.raises(ValueError, match=r"mu must be >= 0; got min -0\.5"):
+    for kw, pattern in [(dict(tol=-1.0), r"settings\.tol = -1\.0 is outside \(0\.0, inf\]"),
+                        (dict(tol=np.nan), r"settings\.tol = nan"),
+                        (dict(max_sweeps=2.5), r"settings\.max_sweeps = 2\.5 must be an integer"),
+                        (dict(max_sweeps=0), r"settings\.max_sweeps = 0 is outside \[1, inf\]"),
+                        (dict(check_every=True), r"settings\.check_every = True must be an integer"),
+                        (dict(criterion="energy"), r"settings\.criterion = 'energy'")]:
+        with pytest.raises(ncd.InputError, match=pattern):
+            ncd.SolverSettings(**kw)
+    with pytest.raises(ncd.InputError, match=r"mu must be >= 0; mu\[0\] = -0\.5"):
         ncd.solve_local(np.eye(2), [-1.0, 0.0], -0.5)
-    with pytest.raises(ValueError, match="positive definite"):
+    with pytest.raises(ncd.InputError, match=r"positive definite .*block 0 = \[\[1\.0, 0\.0\], \[0\.0, -1\.0\]\]"):
         ncd.solve_local(np.diag([1.0, -1.0]), [-1.0, 0.0], 0.5)
-    with pytest.raises(ValueError, match=r"W has shape \(2, 2\), q has length 4"):
+    with pytest.raises(ncd.InputError, match=r"W has shape \(2, 2\), q has length 4"):
         ncd.solve_local(np.eye(2), np.zeros(4), 0.5)
+
+
+# ------------------------------------------------ issue 14: regressions of each reproduced fault
+def run_isolated(code):
+    """Run ``code`` in a fresh interpreter: a segfault or abort is a failure of the
+    test, not of the runner.  Returns its stdout (rc 0 asserted)."""
+    import subprocess
+    import sys
+    proc = subprocess.run([sys.executable, "-c", "import numpy as np, ncd\n" + code],
+                          capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, f"interpreter died with rc {proc.returncode}:\n{proc.stderr[-2000:]}"
+    return proc.stdout
+
+
+ISOLATED = {
+    # segfault (rc 139) before issue 14: index 10**6 read by the NLGS sweep
+    "review_order_local": "ncd.solve_local(2.0 * np.eye(6), -np.ones(6), 0.5, review_order=[0, 1, 10**6])",
+    "review_order_problem": ("s = ncd.make_scene([[0.0, 0.5], [1.0, 0.5], [2.0, 0.5]], 0.5, walls=[((0, 0), (0, 1))])\n"
+                             "p = ncd.prepare_step(s, 1e-3)\n"
+                             "assert p.contacts.n == 5\n"
+                             "ncd.solve_problem(s, p, review_order=[0, 1, 10**6, 2, 3])"),
+    # heap corruption (rc 134/139) before: a guess of 3 values for 3 contacts
+    "guess": "ncd.solve_local(2.0 * np.eye(6), -np.ones(6), 0.5, guess=np.ones(3))",
+}
+MESSAGES = {
+    "review_order_local": r"review_order\[2\] = 1000000 is outside range\(3\)",
+    "review_order_problem": r"review_order\[2\] = 1000000 is outside range\(5\)",
+    "guess": r"guess has shape \(3,\), expected \(3, 2\)",
+}
+
+
+@pytest.mark.parametrize("case", sorted(ISOLATED))
+def test_crash_regressions_raise_input_error(case):
+    """Each crash of issue 14, in a subprocess: now an InputError naming the argument."""
+    code = ("try:\n" + "".join(f"    {line}\n" for line in ISOLATED[case].splitlines())
+            + "except ncd.InputError as err:\n    print('InputError:', err)\nelse:\n    print('accepted')\n")
+    out = run_isolated(code)
+    assert out.startswith("InputError:"), out
+    assert re.search(MESSAGES[case], out), out
+
+
+def test_review_order_of_right_length_but_out_of_range():
+    with pytest.raises(ncd.InputError, match=r"review_order\[2\] = 1000000 is outside range\(3\)"):
+        ncd.solve_local(2.0 * np.eye(6), -np.ones(6), 0.5, review_order=[0, 1, 10**6])
+
+
+@pytest.mark.parametrize("order, pattern", [
+    ([0, 0], r"not a permutation of range\(2\): 0 appears 2 times and 1 is missing"),
+    ([1, -1], r"review_order\[1\] = -1 is outside range\(2\)"),
+    ([0.0, 1.0], r"must hold integers.*float64"),
+    ([0, 1, 2, 3], r"got shape \(4,\)"),
+    ([[0, 1]], r"got shape \(1, 2\)"),
+    ("01", r"got shape \(\)"),
+])
+def test_review_order_must_be_a_permutation(order, pattern):
+    """[0, 0] used to skip contact 1 silently (20,000 sweeps, residual 0.52)."""
+    W, q = 2.0 * np.eye(4), -np.ones(4)
+    with pytest.raises(ncd.InputError, match=pattern):
+        ncd.solve_local(W, q, 0.5, review_order=order)
+    s = scene(pos=[[0.0, 0.5], [1.0, 0.5]])
+    p = ncd.prepare_step(s, 1e-3)
+    assert p.contacts.n == 3
+    with pytest.raises(ncd.InputError, match="review_order"):
+        ncd.solve_problem(s, p, review_order=order)
+
+
+@pytest.mark.parametrize("where", ["W", "q"])
+@pytest.mark.parametrize("value", [np.nan, np.inf])
+def test_non_finite_local_problem_refused_up_front(where, value):
+    """NaN in W or q used to run 20,000 sweeps and return NaN."""
+    W, q = 2.0 * np.eye(6), -np.ones(6)
+    (W if where == "W" else q)[(0, 3) if where == "W" else 1] = value
+    with pytest.raises(ncd.InputError, match=rf"{where} must be finite; {where}\[.*\] = {value}"):
+        ncd.solve_local(W, q, 0.5)
+    with pytest.raises(ncd.InputError, match=rf"{where} must be finite"):
+        ncd.solve_local(__import__("scipy.sparse").sparse.csr_matrix(W), q, 0.5)
+
+
+@pytest.mark.parametrize("mu", [np.inf, np.nan, -1.0, [0.5, np.inf, 0.5]])
+def test_mu_must_be_finite_and_non_negative(mu):
+    with pytest.raises(ncd.InputError, match=r"mu must be"):
+        ncd.solve_local(2.0 * np.eye(6), -np.ones(6), mu)
+    with pytest.raises(ncd.InputError, match=r"mu"):
+        ncd.solve_single_contact_py(np.eye(2), [-1.0, 0.0], np.asarray(mu).ravel()[np.size(mu) // 2])
+    if np.ndim(mu) == 0:
+        with pytest.raises(ncd.InputError, match=r"mu = "):
+            scene(mu=mu)
+        with pytest.raises(ncd.InputError, match=r"mu = "):
+            ncd.project_cone(1.0, 0.0, mu)
+
+
+def test_gap_tolerance_nan_is_refused():
+    """step(gap_tolerance=nan) used to drop every contact and report converged=True."""
+    s = scene()
+    for tol in (np.nan, -1e-3, np.inf):
+        with pytest.raises(ncd.InputError, match=rf"gap_tolerance = {tol} is outside \[0\.0, inf\]"):
+            ncd.step(s, 1e-3, gap_tolerance=tol)
+    assert s.time == 0.0
+    rep = ncd.step(s, 1e-3, gap_tolerance=0.0)      # the contacts with the floor are kept
+    assert rep.n_contacts == 2 and rep.converged
+
+
+@pytest.mark.parametrize("pos", [np.zeros((2, 3)), np.zeros(4), np.zeros((1, 2, 2)), [[0.0, 0.5], [1.0]]])
+def test_pos_must_have_shape_n_by_2(pos):
+    """pos of shape (2, 3) used to be read as 3 discs."""
+    with pytest.raises(ncd.InputError, match=r"pos (has shape|= ).*"):
+        ncd.make_scene(pos, 0.1)
+
+
+def test_empty_local_problem_returns_an_empty_converged_result():
+    """It used to raise AttributeError."""
+    for W in (np.zeros((0, 0)), __import__("scipy.sparse").sparse.csr_matrix((0, 0))):
+        r = ncd.solve_local(W, np.zeros(0), 0.5)
+        assert r.impulse.shape == (0, 2) and r.status.shape == (0,)
+        assert r.converged and r.sweeps == 0 and r.residual == 0.0
+
+
+def test_guess_of_wrong_shape_or_non_finite():
+    W, q = 2.0 * np.eye(6), -np.ones(6)
+    for guess, pattern in [(np.ones(3), r"guess has shape \(3,\), expected \(3, 2\)"),
+                           (np.ones((2, 2)), r"guess has shape \(2, 2\)"),
+                           (np.full((3, 2), np.nan), r"guess must be finite; guess\[0, 0\] = nan")]:
+        with pytest.raises(ncd.InputError, match=pattern):
+            ncd.solve_local(W, q, 0.5, guess=guess)
+    r = ncd.solve_local(W, q, 0.5, guess=np.ones(6))       # the flat layout of q is accepted
+    assert r.converged and np.allclose(r.impulse[:, 0], 0.5)
+
+
+def test_non_symmetric_block_policy():
+    """A non-symmetric diagonal block is accepted when x.Bx > 0 (its symmetric part
+    is positive definite) and solved; refused otherwise, with the block's values."""
+    W = np.array([[2.0, 0.5], [-0.5, 1.0]])        # symmetric part diag(2, 1)
+    r = ncd.solve_local(W, [-1.0, 0.2], 0.3)
+    assert r.converged
+    (rn, rt), (un, ut) = r.impulse[0], W @ r.impulse[0] + [-1.0, 0.2]
+    assert rn > 0 and un == pytest.approx(0.0, abs=1e-12)          # closed contact
+    assert abs(rt) <= 0.3 * rn * (1 + 1e-12)
+    assert abs(rt) == pytest.approx(0.3 * rn) and ut * rt < 0 or ut == pytest.approx(0.0, abs=1e-12)
+    with pytest.raises(ncd.InputError, match=r"block 0 = \[\[1\.0, 3\.0\], \[0\.0, 1\.0\]\] is not"):
+        ncd.solve_local(np.array([[1.0, 3.0], [0.0, 1.0]]), [-1.0, 0.0], 0.3)   # det 1 > 0 but x.Bx < 0 somewhere
+
+
+def test_diverging_nlgs_is_a_simulation_error_not_nan():
+    """An indefinite coupling (the diagonal blocks are fine) makes NLGS blow up;
+    the result is refused instead of coming back non-finite."""
+    W = np.array([[1.0, 0.0, -50.0, 0.0], [0.0, 1.0, 0.0, 0.0], [-50.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]])
+    with np.errstate(all="ignore"):
+        try:
+            r = ncd.solve_local(W, [-1.0, 0.0, -1.0, 0.0], 0.0, settings=ncd.SolverSettings(max_sweeps=2000))
+        except ncd.SimulationError as err:
+            assert "non-finite" in str(err)
+        else:
+            assert np.all(np.isfinite(r.impulse)) and not r.converged
+
+
+@pytest.mark.parametrize("call, pattern", [
+    (lambda s, p: ncd.detect_contacts(s, alert=np.nan), r"alert = nan"),
+    (lambda s, p: ncd.detect_contacts(s, pos=np.zeros((3, 2))), r"pos has shape \(3, 2\), expected \(2, 2\)"),
+    (lambda s, p: ncd.detect_contacts("scene"), r"scene must be an ncd.Scene"),
+    (lambda s, p: ncd.prepare_step(s, 1e-3, vel=np.zeros((3, 2))), r"vel has shape \(3, 2\)"),
+    (lambda s, p: ncd.solve_problem(s, "problem"), r"problem must be an ncd.StepProblem"),
+    (lambda s, p: ncd.solve_problem(s, p, guess=np.ones((5, 2))), r"guess has shape \(5, 2\), expected \(2, 2\)"),
+    (lambda s, p: ncd.solve_problem(s, p, settings={"tol": 1e-8}), r"settings must be an ncd.SolverSettings"),
+    (lambda s, p: ncd.step(s, 1e-3, init=np.ones(3)), r"init has shape \(3,\), expected \(2, 2\)"),
+    (lambda s, p: ncd.step(s, 1e-3, speed_limit=np.nan), r"speed_limit = nan"),
+    (lambda s, p: ncd.equilibrium_test(s, 1e-3, velocity_tol=-1.0), r"velocity_tol = -1\.0"),
+    (lambda s, p: ncd.kinetic_energy(None), r"scene must be an ncd.Scene"),
+    (lambda s, p: ncd.solve_single_contact_py(np.eye(3), [0.0, 0.0], 0.5), r"W has shape \(3, 3\), expected \(2, 2\)"),
+    (lambda s, p: ncd.project_cone(np.nan, 0.0, 0.5), r"zn = nan"),
+])
+def test_entry_points_name_the_argument(call, pattern):
+    s = scene()
+    p = ncd.prepare_step(s, 1e-3)
+    with pytest.raises(ncd.InputError, match=pattern):
+        call(s, p)
+    assert s.time == 0.0
+
+
+def test_inconsistent_scene_and_problem_never_reach_a_kernel():
+    """A scene edited by hand (a wrong vel shape) or a problem of another scene."""
+    s = scene()
+    s.vel = np.zeros((5, 2))
+    with pytest.raises(ncd.InputError, match=r"scene\.vel has shape \(5, 2\), expected \(2, 2\)"):
+        ncd.step(s, 1e-3)
+    big = scene(pos=[[0.0, 0.5], [1.0, 0.5], [2.0, 0.5]])
+    p = ncd.prepare_step(big, 1e-3)
+    with pytest.raises(ncd.InputError, match=r"problem\.contacts\.body_a|problem\.free_vel|body_b"):
+        ncd.solve_problem(scene(), p)
+    p.contacts.body_b[0] = 99
+    with pytest.raises(ncd.InputError, match=r"problem\.contacts\.body_b must be another disc"):
+        ncd.solve_problem(big, p)
+
+
+@pytest.mark.parametrize("kw, pattern", [
+    (dict(members=[0, -1]), r"members must be >= 0"),
+    (dict(members=[0.5]), r"members must be a 1-D array of integers"),
+    (dict(root_seed=-3), r"root_seed = -3 is outside"),
+    (dict(root_seed=1.5), r"root_seed = 1\.5 must be an integer"),
+    (dict(init="random"), r"needs guess_scale > 0, got None"),
+    (dict(init="random", guess_scale=np.inf), r"guess_scale = inf is outside"),
+    (dict(init="hot"), r"init = 'hot'"),
+    (dict(review="sorted"), r"review = 'sorted'"),
+    (dict(threads=0), r"threads = 0 is outside"),
+    (dict(progress=3), r"progress = 3 must be callable"),
+])
+def test_explore_rejects(kw, pattern):
+    from ncd.explore import explore
+    s = scene()
+    p = ncd.prepare_step(s, 1e-3)
+    args = dict(members=[0, 1], root_seed=7)
+    args.update(kw)
+    with pytest.raises(ncd.InputError, match=pattern):
+        explore(s, p, **args)
+
+
+def test_mass_ratio_1e12_and_tiny_discs():
+    """A mass ratio of 1e12 steps without error; a mass that underflows is refused."""
+    s = ncd.make_scene([[0.0, 0.5], [0.0, 1.5]], 0.5, [1.0, 1e12], walls=FLOOR)
+    for _ in range(5):
+        rep = ncd.step(s, 1e-3)
+    assert np.all(np.isfinite(s.vel)) and rep.n_contacts == 2
+    with pytest.raises(ncd.InputError, match=r"disc 0: mass 0 .* must be finite and > 0"):
+        ncd.make_scene([[0.0, 0.5]], 1e-200, 1.0)
+    with pytest.raises(ncd.InputError, match=r"disc 0: mass inf"):
+        ncd.make_scene([[0.0, 0.5]], 1e200, 1e200)

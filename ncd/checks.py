@@ -1,0 +1,446 @@
+"""Checks of the arguments of the public API (issue 14: unbreakable inputs).
+
+Every public entry point calls these first, so that no numba kernel is ever
+reached with inconsistent sizes, out-of-range indices or non-finite data.  Each
+check raises :class:`ncd.InputError` (a ``ValueError``) naming the argument and
+the offending value, and returns the argument in the form the kernels read.
+
+Policies:
+
+* arrays must hold real numbers (no strings, booleans, complex or ragged lists)
+  and have exactly the stated shape (``pos`` of shape (2, 3) is refused, never
+  reshaped); scalars are real, finite, within the stated range;
+* a ``review_order`` is a permutation of ``range(n)`` of integer dtype;
+* an impulse guess has shape ``(n, 2)`` or the flat ``(2 n,)`` of ``q``;
+* a Delassus matrix ``W`` given to :func:`ncd.solve_local` is square ``2 n``,
+  finite, and each diagonal 2x2 block ``B`` (the contact's own) is positive
+  definite in the sense ``x . B x > 0`` for ``x != 0``, i.e. its symmetric part
+  is: ``B_nn > 0``, ``B_tt > 0``, ``B_nn B_tt > ((B_nt + B_tn) / 2)^2``.
+  Non-symmetric blocks (which the single-contact solver of
+  :mod:`ncd.local_solver` handles) are accepted under this condition, which
+  makes the block invertible (``det B = det S + a^2 > 0``).  The coupling blocks
+  are not checked: an NLGS that diverges on them ends in
+  :class:`ncd.SimulationError` (:func:`finite_result`), never in silent NaN.
+"""
+import numbers
+
+import numpy as np
+import scipy.sparse as sp
+
+from .model import InputError, Scene, SimulationError
+
+MAX_GRID_CELLS = 1e7      # cells of the periodic detection grid (8 bytes each)
+
+
+def _show(value):
+    text = repr(value)
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
+def _first_bad(name, arr, bad, why):
+    idx = np.argwhere(bad)[0]
+    where = ", ".join(str(int(i)) for i in idx)
+    raise InputError(f"{name} {why}; {name}[{where}] = {arr[tuple(idx)]}")
+
+
+def real(name, value, lo=-np.inf, hi=np.inf, lo_open=False, hi_open=False, allow_inf=False):
+    """``value`` as a float in the interval ``lo .. hi`` (closed unless ``*_open``),
+    finite unless ``allow_inf``."""
+    if isinstance(value, (str, bytes, bool, np.bool_)) or np.ndim(value) != 0:
+        raise InputError(f"{name} = {_show(value)} must be a real number")
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} = {_show(value)} must be a real number") from None
+    if isinstance(value, complex) or np.iscomplexobj(value):
+        raise InputError(f"{name} = {_show(value)} must be a real number")
+    ok = (np.isfinite(v) or (allow_inf and not np.isnan(v))) and lo <= v <= hi \
+        and not (lo_open and v == lo) and not (hi_open and v == hi)
+    if not ok:
+        span = ("(" if lo_open else "[") + f"{lo}, {hi}" + (")" if hi_open else "]")
+        raise InputError(f"{name} = {value!r} is outside {span}")
+    return v
+
+
+def integer(name, value, lo=None, hi=None):
+    """``value`` as an int (an integer type, not a float or a bool) in ``[lo, hi]``."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
+        raise InputError(f"{name} = {_show(value)} must be an integer")
+    v = int(value)
+    if (lo is not None and v < lo) or (hi is not None and v > hi):
+        raise InputError(f"{name} = {v} is outside [{lo}, {'inf' if hi is None else hi}]")
+    return v
+
+
+def _shape_text(shape):
+    return "(" + ", ".join("any" if s is None else str(s) for s in shape) + ("," if len(shape) == 1 else "") + ")"
+
+
+def array(name, value, shape, finite=True, dtype=float):
+    """``value`` as a C-contiguous array of ``dtype`` with exactly ``shape``
+    (``None`` entries: any length), every entry finite unless ``finite=False``."""
+    try:
+        raw = np.asarray(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} = {_show(value)} is not an array of numbers") from None
+    if raw.dtype.kind not in "iuf" and not (raw.size == 0 and raw.dtype.kind in "iufbO"):
+        raise InputError(f"{name} must hold real numbers; got dtype {raw.dtype}: {_show(value)}")
+    if raw.ndim != len(shape) or any(s is not None and s != k for s, k in zip(shape, raw.shape)):
+        raise InputError(f"{name} has shape {raw.shape}, expected {_shape_text(shape)}")
+    arr = np.ascontiguousarray(raw, dtype=dtype)
+    if finite and arr.size and not np.isfinite(arr).all():
+        _first_bad(name, arr, ~np.isfinite(arr), "must be finite")
+    return arr
+
+
+def per_item(name, value, n, lo=-np.inf, hi=np.inf, lo_open=False):
+    """A scalar broadcast to ``(n,)`` or an ``(n,)`` array, finite, in ``[lo, hi]``."""
+    arr = array(name, value, () if np.ndim(value) == 0 else (n,))
+    arr = np.broadcast_to(arr, (n,)).copy()
+    bad = (arr < lo) | (arr > hi) | ((arr == lo) if lo_open else False)
+    if np.any(bad):
+        op = ">" if lo_open else ">="
+        why = f"must be {op} {lo:g}" if hi == np.inf else f"must be in {'(' if lo_open else '['}{lo:g}, {hi:g}]"
+        _first_bad(name, arr, bad, why)
+    return arr
+
+
+def permutation(name, order, n):
+    """``order`` as an int64 permutation of ``range(n)`` (the identity if None)."""
+    if order is None:
+        return np.arange(n, dtype=np.int64)
+    try:
+        raw = np.asarray(order)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} = {_show(order)} is not an array of integers") from None
+    if raw.ndim != 1 or len(raw) != n:
+        raise InputError(f"{name} must be a permutation of range({n}); got shape {raw.shape}: {_show(order)}")
+    if n == 0:
+        return np.zeros(0, np.int64)
+    if raw.dtype.kind not in "iu":
+        raise InputError(f"{name} must hold integers, a permutation of range({n}); got dtype {raw.dtype}")
+    if raw.dtype.kind == "u" and raw.max() >= n:
+        k = int(np.argmax(raw))
+        raise InputError(f"{name}[{k}] = {raw[k]} is outside range({n})")
+    arr = np.ascontiguousarray(raw, dtype=np.int64)
+    bad = (arr < 0) | (arr >= n)
+    if np.any(bad):
+        k = int(np.argmax(bad))
+        raise InputError(f"{name}[{k}] = {arr[k]} is outside range({n})")
+    counts = np.bincount(arr, minlength=n)
+    if counts.max() > 1:
+        dup, missing = int(np.argmax(counts)), int(np.argmin(counts))
+        raise InputError(f"{name} is not a permutation of range({n}): {dup} appears {counts[dup]} "
+                         f"times and {missing} is missing")
+    return arr
+
+
+def impulse_guess(name, guess, n):
+    """An initial impulse array: None (zeros), shape (n, 2) or (2 n,); finite."""
+    if guess is None:
+        return np.zeros((n, 2))
+    shape = np.shape(guess) if not isinstance(guess, (str, bytes)) else ()
+    if shape not in ((n, 2), (2 * n,)):
+        raise InputError(f"{name} has shape {shape}, expected ({n}, 2) (one impulse per contact)")
+    return array(name, guess, shape).reshape(n, 2).copy()
+
+
+def solver_settings(settings, name="settings"):
+    """Field checks of :class:`ncd.SolverSettings` (called by its ``__post_init__``)."""
+    from .nlgs import CRITERIA, SolverSettings
+    if not isinstance(settings, SolverSettings):
+        raise InputError(f"{name} must be an ncd.SolverSettings; got {_show(settings)}")
+    real(f"{name}.tol", settings.tol, 0.0, lo_open=True)
+    integer(f"{name}.max_sweeps", settings.max_sweeps, 1)
+    integer(f"{name}.check_every", settings.check_every, 1)
+    if not isinstance(settings.criterion, str) or settings.criterion not in CRITERIA:
+        raise InputError(f"{name}.criterion = {settings.criterion!r} must be one of {sorted(CRITERIA)}")
+    from . import nlgs
+    finishes = getattr(nlgs, "FINISHES", None)
+    if finishes is not None and getattr(settings, "finish", None) not in finishes:
+        raise InputError(f"{name}.finish = {getattr(settings, 'finish', None)!r} must be one of {finishes}")
+    for field in ("finish_tol", "observable_tol"):
+        if hasattr(settings, field):
+            real(f"{name}.{field}", getattr(settings, field), 0.0, lo_open=True)
+    if hasattr(settings, "keep_best") and not isinstance(settings.keep_best, (bool, np.bool_)):
+        raise InputError(f"{name}.keep_best = {settings.keep_best!r} must be True or False")
+    return settings
+
+
+# ------------------------------------------------------------ scenes and steps
+def scene(s, name="scene"):
+    """A :class:`ncd.Scene` whose arrays are consistent: the shapes the kernels
+    index, finite radii, masses and laws.  The *state* (``pos``, ``vel``,
+    ``spin``, ``angle``) is only shape-checked: a state gone non-finite is a
+    :class:`ncd.SimulationError` of the stepper."""
+    if not isinstance(s, Scene):
+        raise InputError(f"{name} must be an ncd.Scene (build it with ncd.make_scene); got {type(s).__name__}")
+    nd = np.shape(s.radius)[0] if np.ndim(s.radius) == 1 else -1
+    if nd < 1:
+        raise InputError(f"{name}.radius has shape {np.shape(s.radius)}, expected (n_disc,) with n_disc >= 1")
+    integer(f"{name}.n_mobile", s.n_mobile, 1, nd)
+    for field, shape, fin in (("radius", (nd,), True), ("inv_mass", (nd,), True), ("inv_inertia", (nd,), True),
+                              ("mass", (nd,), False), ("pos", (nd, 2), False), ("vel", (nd, 2), False),
+                              ("spin", (nd,), False), ("angle", (nd,), False),
+                              ("wall_point", (None, 2), True), ("wall_normal", (None, 2), True),
+                              ("gravity", (2,), True)):
+        value = getattr(s, field)
+        if not isinstance(value, np.ndarray):
+            raise InputError(f"{name}.{field} must be a numpy array; got {_show(value)}")
+        array(f"{name}.{field}", value, shape, finite=fin)
+    if np.any(s.radius <= 0):
+        _first_bad(f"{name}.radius", s.radius, s.radius <= 0, "must be > 0")
+    if np.any(s.inv_mass[: s.n_mobile] <= 0):
+        _first_bad(f"{name}.inv_mass", s.inv_mass, s.inv_mass <= 0, "must be > 0 for mobile discs")
+    if np.any(s.inv_mass < 0) or np.any(s.inv_inertia < 0):
+        raise InputError(f"{name}.inv_mass and inv_inertia must be >= 0")
+    if len(s.wall_point) != len(s.wall_normal):
+        raise InputError(f"{name}.wall_point has {len(s.wall_point)} rows, wall_normal {len(s.wall_normal)}")
+    for law in ("mu", "mu_obstacle"):
+        real(f"{name}.{law}", getattr(s, law), 0.0)
+    for law in ("e_n", "e_t", "e_n_obstacle", "e_t_obstacle"):
+        real(f"{name}.{law}", getattr(s, law), 0.0, 1.0)
+    real(f"{name}.period", s.period, 0.0)
+    if (s.prev_keys is None) != (s.prev_impulse is None) or (
+            s.prev_keys is not None and (np.ndim(s.prev_keys) != 1
+                                         or np.shape(s.prev_impulse) != (len(s.prev_keys), 2))):
+        raise InputError(f"{name}.prev_keys and prev_impulse must be None or of shapes (k,) and (k, 2); "
+                         f"got {np.shape(s.prev_keys)} and {np.shape(s.prev_impulse)}")
+    return s
+
+
+def contacts(s, c, name="contacts"):
+    """A :class:`ncd.Contacts` of ``s``: every field of length ``n``, disc
+    indices in range (``body_a`` mobile, ``body_b`` a disc or ``-1 - wall``),
+    unit normals, finite arms and laws."""
+    from .contacts import Contacts
+    if not isinstance(c, Contacts):
+        raise InputError(f"{name} must be an ncd.Contacts; got {type(c).__name__}")
+    n = np.shape(c.body_a)[0] if np.ndim(c.body_a) == 1 else -1
+    if n < 0:
+        raise InputError(f"{name}.body_a has shape {np.shape(c.body_a)}, expected (n,)")
+    for field in ("body_a", "body_b", "key"):
+        value = np.asarray(getattr(c, field))
+        if value.shape != (n,) or (n and value.dtype.kind not in "iu"):
+            raise InputError(f"{name}.{field} must be integers of shape ({n},); got {value.dtype} {value.shape}")
+    for field, shape in (("normal", (n, 2)), ("point", (n, 2)), ("gap", (n,)), ("arm_a", (n,)),
+                         ("arm_b", (n,)), ("shift_b", (n,)), ("mu", (n,)), ("e_n", (n,)), ("e_t", (n,))):
+        array(f"{name}.{field}", getattr(c, field), shape)
+    if n == 0:
+        return c
+    a, b = np.asarray(c.body_a), np.asarray(c.body_b)
+    bad = (a < 0) | (a >= s.n_mobile)
+    if np.any(bad):
+        _first_bad(f"{name}.body_a", a, bad, f"must be a mobile disc in range({s.n_mobile})")
+    bad = (b < -len(s.wall_point)) | (b >= s.n_disc) | (a == b)
+    if np.any(bad):
+        _first_bad(f"{name}.body_b", b, bad,
+                   f"must be another disc in range({s.n_disc}) or -1 - wall with {len(s.wall_point)} walls")
+    norm = np.hypot(c.normal[:, 0], c.normal[:, 1])
+    if np.any(np.abs(norm - 1.0) > 1e-6):
+        k = int(np.argmax(np.abs(norm - 1.0)))
+        raise InputError(f"{name}.normal[{k}] = {c.normal[k]} is not a unit vector")
+    if np.any(np.asarray(c.mu) < 0):
+        _first_bad(f"{name}.mu", np.asarray(c.mu), np.asarray(c.mu) < 0, "must be >= 0")
+    for field in ("e_n", "e_t"):
+        e = np.asarray(getattr(c, field))
+        if np.any((e < 0) | (e > 1)):
+            _first_bad(f"{name}.{field}", e, (e < 0) | (e > 1), "must be in [0, 1]")
+    return c
+
+
+def disc_blocks(W, n, name="W"):
+    """Delassus blocks of disc contacts, (n, 2, 2): finite, diagonal, ``W_nn, W_tt > 0``."""
+    W = array(name, W, (n, 2, 2))
+    if n and (np.any(W[:, 0, 1] != 0) or np.any(W[:, 1, 0] != 0)):
+        k = int(np.argmax((W[:, 0, 1] != 0) | (W[:, 1, 0] != 0)))
+        raise InputError(f"{name}[{k}] = {W[k].tolist()}: disc contacts have diagonal Delassus blocks "
+                         "(use solve_local for a general W)")
+    if n and (np.any(W[:, 0, 0] <= 0) or np.any(W[:, 1, 1] <= 0)):
+        k = int(np.argmax((W[:, 0, 0] <= 0) | (W[:, 1, 1] <= 0)))
+        raise InputError(f"{name}[{k}] = {W[k].tolist()} is not positive definite")
+    return W
+
+
+def disc_problem(s, c, vel, spin, guess, review_order, settings, bias, W):
+    """All arguments of :func:`ncd.solve_discs`; returns ``(guess, order, bias)``."""
+    scene(s)
+    contacts(s, c)
+    n, nd = c.n, s.n_disc
+    for nm_, value, shape in (("vel", vel, (nd, 2)), ("spin", spin, (nd,))):
+        if not (isinstance(value, np.ndarray) and value.dtype == np.float64 and value.flags.writeable):
+            raise InputError(f"{nm_} must be a writeable float64 numpy array of shape {shape} (modified in place); "
+                             f"got {_show(value)}")
+        array(nm_, value, shape)
+    solver_settings(settings)
+    W = None if W is None else disc_blocks(W, n)
+    bias = np.zeros((n, 2)) if bias is None else array("bias", bias, (n, 2))
+    return impulse_guess("guess", guess, n), permutation("review_order", review_order, n), bias, W
+
+
+def step_problem(s, problem, name="problem"):
+    """A :class:`ncd.StepProblem` built for ``s`` (:func:`ncd.prepare_step`)."""
+    from .stepper import StepProblem
+    scene(s)
+    if not isinstance(problem, StepProblem):
+        raise InputError(f"{name} must be an ncd.StepProblem (from ncd.prepare_step); got {type(problem).__name__}")
+    contacts(s, problem.contacts, f"{name}.contacts")
+    n, nd = problem.contacts.n, s.n_disc
+    disc_blocks(problem.W, n, f"{name}.W")
+    array(f"{name}.free_vel", problem.free_vel, (nd, 2))
+    array(f"{name}.free_spin", problem.free_spin, (nd,))
+    array(f"{name}.bias", problem.bias, (n, 2))
+    return problem
+
+
+def step_args(h, theta, gap_tolerance, vel=None, spin=None, n_disc=None):
+    """Scalars of :func:`ncd.prepare_step` / :func:`ncd.step`; ``vel, spin`` when given."""
+    try:
+        hv = real("h", h, allow_inf=True)
+    except InputError:
+        hv = np.nan
+    if not (np.isfinite(hv) and hv > 0):
+        raise InputError(f"time step h = {h!r} must be > 0")
+    try:
+        real("theta", theta, 0.0, 1.0, lo_open=True)
+    except InputError:
+        raise InputError(f"theta = {theta!r} must be in (0, 1]") from None
+    if gap_tolerance is not None:
+        real("gap_tolerance", gap_tolerance, 0.0)
+    if vel is not None:
+        array("vel", vel, (n_disc, 2))
+    if spin is not None:
+        array("spin", spin, (n_disc,))
+
+
+def step_call(s, h, theta=0.5, settings=None, init="zero", gap_tolerance=None, speed_limit=np.inf,
+              velocity_tol=None):
+    """Arguments of :func:`ncd.step` and :func:`ncd.equilibrium_test` known before
+    the contacts are (``init``'s shape and ``review_order`` are checked once they are)."""
+    scene(s)
+    step_args(h, theta, gap_tolerance)
+    if settings is not None:
+        solver_settings(settings)
+    if isinstance(init, str):
+        if init not in ("zero", "warm"):
+            raise InputError(f"init = {init!r} must be 'zero', 'warm' or an impulse array")
+    elif init is not None:
+        array("init", init, (None,) * np.ndim(init))
+    real("speed_limit", speed_limit, 0.0, lo_open=True, allow_inf=True)
+    if velocity_tol is not None:
+        real("velocity_tol", velocity_tol, 0.0)
+
+
+def detection_args(s, alert, pos):
+    """Arguments of :func:`ncd.detect_contacts`; returns ``pos`` (the scene's if None)."""
+    scene(s)
+    alert = real("alert", alert, 0.0)
+    pos = array("pos", s.pos if pos is None else pos, (s.n_disc, 2))
+    if s.period > 0:      # the grid of ncd.detection: period / cell columns, height / cell rows
+        cell = 2.0 * s.radius.max() + alert
+        cells = max(1.0, s.period / cell) * (np.ptp(pos[:, 1]) / cell + 1.0)
+        if cells > MAX_GRID_CELLS:
+            raise InputError(f"the periodic detection grid would need {cells:.3g} cells (> {MAX_GRID_CELLS:.0g}): "
+                             f"period {s.period:.3g} and height {np.ptp(pos[:, 1]):.3g} for a cell of {cell:.3g}")
+    elif np.abs(pos).max() > 1e150:
+        raise InputError(f"pos must be below 1e150 in magnitude; got {np.abs(pos).max():.3g}")
+    return pos
+
+
+def explore_args(s, problem, members, root_seed, init, review, guess_scale, settings, progress, threads):
+    """Arguments of :func:`ncd.explore.explore`; returns ``members`` as int64."""
+    from .explore import INIT_MODES
+    step_problem(s, problem)
+    members = np.asarray(members) if not isinstance(members, (str, bytes)) else np.asarray(None)
+    if members.ndim != 1 or (members.size and members.dtype.kind not in "iu"):
+        raise InputError(f"members must be a 1-D array of integers; got {members.dtype} {members.shape}")
+    if members.size and members.min() < 0:
+        raise InputError(f"members must be >= 0 (they seed default_rng); got {members.min()}")
+    integer("root_seed", root_seed, 0)
+    if not isinstance(init, str) or init not in INIT_MODES:
+        raise InputError(f"init = {init!r} must be one of {INIT_MODES}")
+    if not isinstance(review, str) or review not in ("fixed", "random"):
+        raise InputError(f"review = {review!r} must be 'fixed' or 'random'")
+    if init == "random" and guess_scale is None:
+        raise InputError("init = 'random' needs guess_scale > 0, got None")
+    if guess_scale is not None:
+        real("guess_scale", guess_scale, 0.0, lo_open=True)
+    solver_settings(settings)
+    if progress is not None and not callable(progress):
+        raise InputError(f"progress = {_show(progress)} must be callable or None")
+    if threads is not None:
+        integer("threads", threads, 1)
+    return members.astype(np.int64)
+
+
+# ------------------------------------------------------------ the local form
+def local_problem(W, q, mu, guess, review_order, settings):
+    """All arguments of :func:`ncd.solve_local` (policy in the module docstring);
+    returns ``(Wc, q, mu, guess, order)`` with ``Wc`` CSR."""
+    q = array("q", q, (None,))
+    if len(q) % 2:
+        raise InputError(f"q has length {len(q)}, expected 2 n (rows n_1, t_1, n_2, ...)")
+    n = len(q) // 2
+    if sp.issparse(W):
+        if W.dtype.kind not in "iuf":
+            raise InputError(f"W must hold real numbers; got dtype {W.dtype}")
+        Wc = sp.csr_matrix(W, dtype=float)
+        Wc.sum_duplicates()
+        if Wc.shape != (2 * n, 2 * n):
+            raise InputError(f"W has shape {Wc.shape}, q has length {len(q)}: expected (2n, 2n) and 2n")
+        if not np.isfinite(Wc.data).all():
+            raise InputError(f"W must be finite; it holds {Wc.data[~np.isfinite(Wc.data)][0]!r}")
+    else:
+        shape = np.shape(W) if not isinstance(W, (str, bytes)) else ()
+        if shape != (2 * n, 2 * n):
+            raise InputError(f"W has shape {shape}, q has length {len(q)}: expected (2n, 2n) and 2n")
+        Wc = sp.csr_matrix(array("W", W, shape))
+    mu = per_item("mu", mu, n, 0.0)
+    if n:
+        rows = np.arange(n) * 2
+        nn, nt = Wc[rows, rows].A1, Wc[rows, rows + 1].A1
+        tn, tt = Wc[rows + 1, rows].A1, Wc[rows + 1, rows + 1].A1
+        bad = ~((nn > 0) & (tt > 0) & (nn * tt > (0.5 * (nt + tn)) ** 2))
+        if np.any(bad):
+            k = int(np.argmax(bad))
+            raise InputError(f"the diagonal 2x2 blocks of W must be positive definite (x.Bx > 0); block {k} "
+                             f"= {[[float(nn[k]), float(nt[k])], [float(tn[k]), float(tt[k])]]} is not")
+    solver_settings(settings)
+    return Wc, q, mu, impulse_guess("guess", guess, n), permutation("review_order", review_order, n)
+
+
+def single_contact(W, q, mu):
+    """Arguments of :func:`ncd.solve_single_contact_py`: a (2, 2) block positive
+    definite as in the module docstring, ``q`` (2,), ``mu >= 0``; all finite."""
+    W = array("W", W, (2, 2))
+    q = array("q", q, (2,))
+    if not (W[0, 0] > 0 and W[1, 1] > 0 and W[0, 0] * W[1, 1] > (0.5 * (W[0, 1] + W[1, 0])) ** 2):
+        raise InputError(f"W = {W.tolist()} must be positive definite (x.Wx > 0)")
+    return W, q, real("mu", mu, 0.0)
+
+
+def finite_output(func):
+    """Decorator of the NLGS entry points: a result (or, in disc form, ``vel`` and
+    ``spin`` modified in place) that is not finite raises :class:`ncd.SimulationError`."""
+    import functools
+    import inspect
+    signature = inspect.signature(func)
+
+    @functools.wraps(func)
+    def checked(*args, **kwargs):
+        result = func(*args, **kwargs)
+        bound = signature.bind(*args, **kwargs).arguments
+        finite_result(result, *(bound[k] for k in ("vel", "spin") if k in bound), where=func.__name__)
+        return result
+    return checked
+
+
+def finite_result(result, *arrays, where="NLGS"):
+    """Raise :class:`ncd.SimulationError` if a returned impulse or velocity is not
+    finite (an NLGS that diverged), instead of handing back NaN."""
+    for a in (result.impulse,) + arrays:
+        if not np.isfinite(a).all():
+            raise SimulationError(f"{where} diverged: non-finite impulses or velocities after "
+                                  f"{result.sweeps} sweeps (residual {result.residual:.3g}); "
+                                  f"is W positive semi-definite and are the data of a sane scale?")
+    return result
