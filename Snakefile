@@ -25,6 +25,9 @@ if workflow.is_main_process and not workflow.dryrun:
 for _figure in FIGURES:
     include: f"workflow/rules/{_figure}.smk"
 
+# the reproduction page results/index.html (claims, verdicts, provenance, run times)
+include: "workflow/rules/index.smk"
+
 # the benchmark suite: `snakemake -j2 bench` (not part of the default target)
 if "bench" in config:
     include: "workflow/rules/bench.smk"
@@ -34,3 +37,4 @@ rule all:
     default_target: True
     input:
         [figure_targets(f) for f in FIGURES],
+        "results/index.html",
