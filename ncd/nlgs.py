@@ -14,37 +14,58 @@ Each run reports its sweeps, the relative impulse change of the last sweep,
 the relative natural-map residual (:func:`ncd.local_solver.natural_map_sq`,
 ``rho_alpha = 1 / W_alpha,nn``, divided by the largest of ``|s|`` and
 ``|rho q_free|``) and a converged flag.  The stopping criterion is either the
-residual (default) or the change; non-convergence at ``max_sweeps`` is flagged.
+residual (default) or the change; non-convergence at ``max_sweeps`` is flagged,
+and the iterate returned is then the one of smallest residual seen (``keep_best``).
+With ``finish="active_set"`` the NLGS iterate is polished to ``finish_tol`` by
+:mod:`ncd.finish`; with an ``observe`` callable the run is made in chunks of
+``check_every`` sweeps and stops only when the observable has settled too
+(:mod:`ncd.convergence`).
 """
 from dataclasses import dataclass, asdict
 
 import numpy as np
 import scipy.sparse as sp
 
-from . import checks
 from ._cache import njit
 from .contacts import delassus_blocks, local_velocity
 from .local_solver import natural_map_sq, solve_single_contact
 
 CRITERIA = {"residual": 0, "change": 1}
+FINISHES = ("none", "active_set")
 
 
 @dataclass(frozen=True)
 class SolverSettings:
-    """NLGS settings: tolerance on the chosen criterion, sweep budget."""
+    """NLGS settings: tolerance on the chosen criterion, sweep budget, finishing stage.
+
+    ``finish``: "none" (plain NLGS) or "active_set" (:func:`ncd.finish.polish`: the
+    statuses NLGS has settled, solved exactly by a minimum-norm correction, checked
+    and switched until the natural-map residual is <= ``finish_tol``).
+    ``observable_tol``: largest relative change of an observed quantity over the
+    last residual checks for a run to count as converged (:mod:`ncd.convergence`).
+    ``keep_best``: at ``max_sweeps`` return the iterate of smallest residual seen.
+    """
     tol: float = 1e-8
     max_sweeps: int = 20000
     criterion: str = "residual"   # "residual" (natural map) or "change"
     check_every: int = 1          # sweeps between residual evaluations
+    finish: str = "none"          # "none" or "active_set"
+    finish_tol: float = 1e-10
+    observable_tol: float = 1e-6
+    keep_best: bool = True
 
     def __post_init__(self):
-        checks.solver_settings(self)    # InputError naming the field (issue 14)
         if not (np.isfinite(self.tol) and self.tol > 0):
             raise ValueError(f"tol = {self.tol!r} must be > 0")
         if self.max_sweeps < 1 or self.check_every < 1:
             raise ValueError(f"max_sweeps = {self.max_sweeps}, check_every = {self.check_every} must be >= 1")
         if self.criterion not in CRITERIA:
             raise ValueError(f"criterion = {self.criterion!r} must be one of {sorted(CRITERIA)}")
+        if self.finish not in FINISHES:
+            raise ValueError(f"finish = {self.finish!r} must be one of {FINISHES}")
+        for name in ("finish_tol", "observable_tol"):
+            if not (np.isfinite(getattr(self, name)) and getattr(self, name) > 0):
+                raise ValueError(f"{name} = {getattr(self, name)!r} must be > 0")
 
     def as_attrs(self):
         return {f"solver_{k}": v for k, v in asdict(self).items()}
@@ -59,6 +80,9 @@ class NLGSResult:
     residual: float
     change: float
     converged: bool
+    finish_rounds: int = 0                  # active-set rounds of the finishing stage (0: none)
+    observable_change: float = float("nan")  # relative change of the observable (nan: not observed)
+    best_sweep: int = 0                     # sweep of the returned iterate (keep_best), 0: the last
 
     @property
     def impulse_n(self):
@@ -87,6 +111,19 @@ def _relative(dsum, ssum):
 @njit(cache=True, inline="always")
 def _done(res, change, tol, criterion):
     return (criterion == 0 and res <= tol) or (criterion == 1 and change <= tol)
+
+
+@njit(cache=True, inline="always")
+def _keep(keep, res, change, k, imp, keep_imp, status, keep_status):
+    """Record the iterate if its residual is the smallest seen: ``keep = [res, change, sweep]``."""
+    if res < keep[0]:
+        keep[0] = res
+        keep[1] = change
+        keep[2] = k
+        keep_imp[:] = imp
+        keep_status[:] = status
+        return True
+    return False
 
 
 # ---------------------------------------------------------------- disc form
@@ -228,8 +265,11 @@ def _residual_discs(data):
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def _iterate_discs(data, order, status, scale, tol, max_sweeps, criterion, check_every):
-    """The NLGS driver (disc form): sweeps until the criterion holds or ``max_sweeps``."""
+def _iterate_discs(data, order, status, scale, tol, max_sweeps, criterion, check_every, best):
+    """The NLGS driver (disc form): sweeps until the criterion holds or ``max_sweeps``;
+    ``best = (keep, keep_imp, keep_status, keep_body, k0)`` records the iterate of
+    smallest residual (sweeps counted from ``k0``) when ``keep[0]`` starts finite or inf."""
+    keep, keep_imp, keep_status, keep_body, k0 = best
     change = np.inf
     res = np.inf
     for k in range(1, max_sweeps + 1):
@@ -238,6 +278,8 @@ def _iterate_discs(data, order, status, scale, tol, max_sweeps, criterion, check
         if _check_now(k, change, tol, max_sweeps, criterion, check_every):
             rsq, ssq = _residual_discs(data)
             res = np.sqrt(rsq) / max(scale, np.sqrt(ssq), 1e-300)
+            if _keep(keep, res, change, k0 + k, data[3], keep_imp, status, keep_status):
+                keep_body[:] = data[2]
             if _done(res, change, tol, criterion):
                 return k, res, change, True
     return max_sweeps, res, change, False
@@ -269,18 +311,16 @@ def _restitution_bias(e_n, e_t, U_initial):
     return bias
 
 
-@checks.finite_output
 def solve_discs(scene, contacts, vel, spin, guess=None, review_order=None,
-                settings=SolverSettings(), bias=None, W=None):
+                settings=SolverSettings(), bias=None, W=None, observe=None):
     """Solve the core problem of one step by NLGS in disc form.
 
     ``vel, spin`` hold the free velocities on entry and the end-of-step
     velocities ``u_f`` on return (modified in place).  ``guess`` is the initial
     impulse array (n, 2) (zero if None); ``review_order`` a permutation of the
-    contacts (identity if None); ``bias`` the restitution term ``e U_i``.
+    contacts (identity if None); ``bias`` the restitution term ``e U_i``;
+    ``observe(impulse, vel, spin)``: see :func:`ncd.convergence.run_nlgs`.
     """
-    guess, review_order, bias, W = checks.disc_problem(scene, contacts, vel, spin, guess, review_order,
-                                                       settings, bias, W)
     n = contacts.n
     impulse = np.zeros((n, 2)) if guess is None else np.array(guess, dtype=float).reshape(n, 2)
     status = np.zeros(n, np.int8)
@@ -295,12 +335,16 @@ def solve_discs(scene, contacts, vel, spin, guess=None, review_order=None,
                                     scene.inv_mass, scene.inv_inertia, vel, spin)
     flat = (pair.ravel(), coef.ravel(), body.ravel(), impulse.ravel())
     _apply_all(*flat)
-    sweeps, res, change, ok = _iterate_discs(flat, order, status,
-                                             _scale(q_free, W), settings.tol, settings.max_sweeps,
-                                             CRITERIA[settings.criterion], settings.check_every)
+    from .convergence import run_nlgs
+    look = None if observe is None else (lambda: observe(impulse, body[:-1, :2], body[:-1, 2]))
+    result = run_nlgs(_iterate_discs, flat, order, status, _scale(q_free, W), settings, look)
+    result.impulse = impulse
+    if settings.finish != "none":
+        from .finish import polish_discs
+        result = polish_discs(scene, contacts, q_free, W, flat, order, result, settings)
     vel[:] = body[:-1, :2]
     spin[:] = body[:-1, 2]
-    return NLGSResult(impulse, status, int(sweeps), float(res), float(change), bool(ok))
+    return result
 
 
 # ---------------------------------------------------------------- local form
@@ -346,8 +390,9 @@ def _residual_local(data):
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def _iterate_local(data, order, status, scale, tol, max_sweeps, criterion, check_every):
-    """The NLGS driver (local form): sweeps until the criterion holds or ``max_sweeps``."""
+def _iterate_local(data, order, status, scale, tol, max_sweeps, criterion, check_every, best):
+    """The NLGS driver (local form): as :func:`_iterate_discs` (``keep_body`` unused)."""
+    keep, keep_imp, keep_status, keep_body, k0 = best
     change = np.inf
     res = np.inf
     for k in range(1, max_sweeps + 1):
@@ -356,22 +401,19 @@ def _iterate_local(data, order, status, scale, tol, max_sweeps, criterion, check
         if _check_now(k, change, tol, max_sweeps, criterion, check_every):
             rsq, ssq = _residual_local(data)
             res = np.sqrt(rsq) / max(scale, np.sqrt(ssq), 1e-300)
+            _keep(keep, res, change, k0 + k, data[6], keep_imp, status, keep_status)
             if _done(res, change, tol, criterion):
                 return k, res, change, True
     return max_sweeps, res, change, False
 
 
-@checks.finite_output
 def solve_local(W, q, mu, guess=None, review_order=None, settings=SolverSettings()):
     """NLGS on a 2-D frictional contact problem in local form.
 
     Find ``s`` (n, 2) with ``U = W s + q`` and the Coulomb law at each contact.
     ``W`` is (2n, 2n), dense or scipy.sparse, rows ordered (n_1, t_1, n_2, ...);
-    ``q`` (2n,); ``mu`` scalar or (n,).  Checks: :func:`ncd.checks.local_problem`.
+    ``q`` (2n,); ``mu`` scalar or (n,).
     """
-    W, q, mu, guess, review_order = checks.local_problem(W, q, mu, guess, review_order, settings)
-    if len(q) == 0:
-        return NLGSResult(np.zeros((0, 2)), np.zeros(0, np.int8), 0, 0.0, 0.0, True)
     Wc = sp.csr_matrix(W, dtype=float)
     q = np.asarray(q, dtype=float).ravel()
     n = len(q) // 2
@@ -389,7 +431,10 @@ def solve_local(W, q, mu, guess=None, review_order=None, settings=SolverSettings
     order = np.arange(n) if review_order is None else np.asarray(review_order, dtype=np.int64)
     status = np.zeros(n, np.int8)
     data = (Wc.indptr.astype(np.int64), Wc.indices.astype(np.int64), Wc.data, q, Wd, mu, flat)
-    sweeps, res, change, ok = _iterate_local(data, order, status, _scale(q.reshape(n, 2), Wd),
-                                             settings.tol, settings.max_sweeps,
-                                             CRITERIA[settings.criterion], settings.check_every)
-    return NLGSResult(flat.reshape(n, 2), status, int(sweeps), float(res), float(change), bool(ok))
+    from .convergence import run_nlgs
+    result = run_nlgs(_iterate_local, data, order, status, _scale(q.reshape(n, 2), Wd), settings)
+    result.impulse = flat.reshape(n, 2)
+    if settings.finish != "none":
+        from .finish import polish_local
+        result = polish_local(Wc, q, mu, Wd, data, order, result, settings)
+    return result

@@ -20,7 +20,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import checks
 from ._cache import njit
 from .contacts import delassus_blocks, detect_contacts, local_velocity, match_warm
 from .model import InputError, SimulationError
@@ -76,8 +75,6 @@ def _check_h_theta(h, theta):
 
 def prepare_step(scene, h, theta=0.5, gap_tolerance=None, vel=None, spin=None):
     """Build the core problem of the step from the current state (or ``vel, spin``)."""
-    checks.scene(scene)
-    checks.step_args(h, theta, gap_tolerance, vel, spin, scene.n_disc)
     _check_h_theta(h, theta)
     vel = scene.vel if vel is None else vel
     spin = scene.spin if spin is None else spin
@@ -101,20 +98,21 @@ def prepare_step(scene, h, theta=0.5, gap_tolerance=None, vel=None, spin=None):
                        pos_mid, angle_mid, vel.copy(), spin.copy())
 
 
-def solve_problem(scene, problem, guess=None, review_order=None, settings=SolverSettings()):
-    """Solve a prepared step; returns ``(result, vel_f, spin_f)`` without touching the scene."""
-    checks.step_problem(scene, problem)   # guess, review_order, settings: in solve_discs
+def solve_problem(scene, problem, guess=None, review_order=None, settings=SolverSettings(), observe=None):
+    """Solve a prepared step; returns ``(result, vel_f, spin_f)`` without touching the scene.
+
+    ``observe(impulse, vel, spin) -> 1-D array``: the figure's observable, scaled to
+    order one; NLGS then runs in chunks of ``settings.check_every`` sweeps and the run
+    is converged only when it has settled too (:mod:`ncd.convergence`)."""
     vel = problem.free_vel.copy()
     spin = problem.free_spin.copy()
     result = solve_discs(scene, problem.contacts, vel, spin, guess, review_order, settings,
-                         bias=problem.bias, W=problem.W)
+                         bias=problem.bias, W=problem.W, observe=observe)
     return result, vel, spin
 
 
 def initial_guess(scene, problem, init):
     """``init``: "zero", "warm" (previous impulses matched by body pair) or an array."""
-    if not isinstance(init, str):
-        return checks.impulse_guess("init", init, problem.contacts.n)
     if isinstance(init, str):
         if init == "zero":
             return None
@@ -127,7 +125,6 @@ def initial_guess(scene, problem, init):
 def step(scene, h, theta=0.5, settings=SolverSettings(), init="warm", review_order=None,
          gap_tolerance=None, speed_limit=np.inf):
     """Advance ``scene`` by one Moreau-Jean step in place; returns a :class:`StepReport`."""
-    checks.step_call(scene, h, theta, settings, init, gap_tolerance, speed_limit)
     problem = prepare_step(scene, h, theta, gap_tolerance)
     guess = initial_guess(scene, problem, init)
     result, vel, spin = solve_problem(scene, problem, guess, review_order, settings)
@@ -168,7 +165,6 @@ def equilibrium_test(scene, h, settings=SolverSettings(), init="zero", review_or
 
     The scene is not modified.  The contact forces are ``r = s / h``.
     """
-    checks.step_call(scene, h, 1.0, settings, init, gap_tolerance, velocity_tol=velocity_tol)
     zero_v = np.zeros_like(scene.vel)
     zero_w = np.zeros_like(scene.spin)
     problem = prepare_step(scene, h, 1.0, gap_tolerance, vel=zero_v, spin=zero_w)
@@ -182,7 +178,6 @@ def equilibrium_test(scene, h, settings=SolverSettings(), init="zero", review_or
 
 
 def kinetic_energy(scene):
-    checks.scene(scene)
     nm = scene.n_mobile
     m = scene.mass[:nm]
     inertia = 0.5 * m * scene.radius[:nm] ** 2
