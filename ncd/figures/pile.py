@@ -8,24 +8,18 @@ arrangement is then explored by NLGS runs from the zero guess with random
 review orders (section 5); the measures of :mod:`ncd.figures.cuts` (cut
 resultants, ground pressure) are kept per run.
 """
-import time
-
 import numpy as np
 import xarray as xr
 
 import ncd
-from ncd.contacts import pair_key
 from ncd.explore import explore, member_rng
 from ncd.io import provenance
 from ncd.model import SimulationError
 from ncd.pipeline import settings as solver_settings
 
 from . import cuts as cm
-
-
-def mean_diameter(cfg):
-    """Mean diameter of the grains (radii uniform in ``[radius_min, radius_max]``)."""
-    return cfg["grains"]["radius_min"] + cfg["grains"]["radius_max"]
+from .construction import build, carry_warm  # noqa: F401 (carry_warm: used by ncd.studies.peer)
+from .sources import PointSource as Source, mean_diameter  # noqa: F401 (the original names)
 
 
 def make_ground(cfg, rng):
@@ -52,140 +46,24 @@ def pile_scene(cfg, pos, radius, ground_pos, ground_radius, vel=None, spin=None,
                           overlap_tolerance=c["overlap_tolerance"])
 
 
-def carry_warm(old, new):
-    """Give ``new`` (``old`` plus grains appended after its mobile discs) the warm-start
-    memory of ``old``: the body-pair keys are re-encoded for the new disc count."""
-    if old.prev_keys is None or len(old.prev_keys) == 0:
-        return
-    base = old.n_disc + 1024   # the key layout of ncd.contacts.pair_key
-    a, b = np.divmod(old.prev_keys, base)
-    added = new.n_mobile - old.n_mobile
-    b = np.where(b >= old.n_mobile, b + added, b)      # obstacles (and walls) shift
-    b_new = np.where(b >= new.n_disc, -1 - (b - new.n_disc), b)
-    keys = pair_key(a, b_new, new.n_disc)
-    order = np.argsort(keys, kind="stable")
-    new.prev_keys = keys[order]
-    new.prev_impulse = old.prev_impulse[order]
-
-
-class Source:
-    """A localized source above the pile axis ``x = 0``: ``slots`` insertion sites in a
-    row, ``drop_height_d`` mean diameters above the settled grains under it (so that
-    impacts stay gentle while the pile grows; the height never decreases)."""
-
-    def __init__(self, cfg, rng, y_ground):
-        s = cfg["source"]
-        g = cfg["grains"]
-        self.cfg, self.rng, self.d = s, rng, mean_diameter(cfg)
-        self.rmin, self.rmax = g["radius_min"], g["radius_max"]
-        pitch = 2.2 * self.rmax
-        self.slots = (np.arange(s["slots"]) - (s["slots"] - 1) / 2) * pitch
-        self.half_width = 0.5 * s["slots"] * pitch
-        self.speed = s["inlet_speed"] * np.sqrt(cfg["gravity"] * self.d)
-        self.height = y_ground + (s["drop_height_d"] + 0.5) * self.d
-        self.settle_speed = 0.2 * np.sqrt(cfg["gravity"] * self.d)
-
-    def update_height(self, pos, radius, vel, age_ok):
-        """Raise the source above the settled grains within one diameter of its span."""
-        near = (np.abs(pos[:, 0]) < self.half_width + self.d) & age_ok
-        near &= np.hypot(vel[:, 0], vel[:, 1]) < self.settle_speed
-        if near.any():
-            top = float(np.max(pos[near, 1] + radius[near]))
-            self.height = max(self.height, top + (self.cfg["drop_height_d"] + 0.5) * self.d)
-
-    def draw(self, pos, radius, limit):
-        """New grains at free sites (clearance ``0.05 d``): positions and radii."""
-        new_p, new_r = [], []
-        clear = 0.05 * self.d
-        for x in self.slots[self.rng.permutation(len(self.slots))]:
-            if len(new_r) >= limit:
-                break
-            r = self.rng.uniform(self.rmin, self.rmax)
-            p = np.array([x + self.rng.uniform(-1, 1) * self.cfg["jitter_d"] * self.d, self.height])
-            ok = len(radius) == 0 or np.min(np.hypot(*(pos - p).T) - radius - r) > clear
-            ok = ok and all(np.hypot(*(q - p)) > r + rq + clear for q, rq in zip(new_p, new_r))
-            if ok:
-                new_p.append(p)
-                new_r.append(r)
-        return np.array(new_p).reshape(-1, 2), np.array(new_r)
-
-
-def construct(cfg, log=None, log_every=10.0):
-    """Pour ``grains.n`` discs and step until at rest (section 2's equilibrium test).
+def construct(cfg, log=None, log_every=10.0, checkpoint=None, checkpoint_every=0, frame_every=0):
+    """Pour ``grains.n`` discs from the localized source and step until at rest
+    (section 2's equilibrium test); :func:`ncd.figures.construction.build` is the loop.
 
     Returns ``(scene, record, ground, eq)``: the final scene, the per-step record
     (dict of arrays), the ground discs ``(pos, radius)`` and the warm-started
-    :class:`ncd.EquilibriumResult` of the final state (the history forces).
+    :class:`ncd.EquilibriumResult` of the final state (the history forces); with
+    ``frame_every > 0`` also the frames ``(frame_steps, frames)``.
     Raises :class:`SimulationError` if a grain leaves the ground or if the pile is not
     at rest after ``max_steps``.  Progress goes to ``log`` every ``log_every`` seconds.
     """
-    c = cfg["construction"]
     rng = member_rng(0, cfg["seed"])
-    ground_pos, ground_radius = make_ground(cfg, rng)
-    y_ground = float(np.mean(ground_radius))
-    d = mean_diameter(cfg)
-    h = cfg["h"]
-    n_target = cfg["grains"]["n"]
-    settings = solver_settings(c["settings"])
-    eq_settings = solver_settings(c["equilibrium"])
-    source = Source(cfg, rng, y_ground)
-    born = np.zeros(0, np.int64)
-    min_age = int(np.ceil(0.5 * np.sqrt(d / cfg["gravity"]) / h))
-    rest_speed = c["rest_speed"] * np.sqrt(cfg["gravity"] * d)
-    x_edge = ground_pos[:, 0].max()
-    scene = None
-    rec = {k: [] for k in ("time", "n_grains", "kinetic_energy", "sweeps", "residual", "converged",
-                           "n_contacts", "max_penetration", "source_height", "wall_time")}
-    last_log = time.perf_counter()
-    for k in range(1, c["max_steps"] + 1):
-        nm = 0 if scene is None else scene.n_mobile
-        if nm < n_target and (k - 1) % cfg["source"]["insert_every"] == 0:
-            st = (scene.pos[:nm], scene.radius[:nm], scene.vel[:nm], scene.spin[:nm], scene.angle[:nm]) \
-                if scene else (np.zeros((0, 2)), np.zeros(0), np.zeros((0, 2)), np.zeros(0), np.zeros(0))
-            source.update_height(st[0], st[1], st[2], k - born >= min_age)
-            p, r = source.draw(st[0], st[1], n_target - nm)
-            if len(r):
-                vel = np.vstack([st[2], np.tile([0.0, -source.speed], (len(r), 1))])
-                new = pile_scene(cfg, np.vstack([st[0], p]), np.concatenate([st[1], r]), ground_pos,
-                                 ground_radius, vel=vel, spin=np.concatenate([st[3], np.zeros(len(r))]),
-                                 angle=np.concatenate([st[4], np.zeros(len(r))]))
-                if scene is not None:
-                    new.time = scene.time
-                    carry_warm(scene, new)
-                scene = new
-                born = np.concatenate([born, np.full(len(r), k)])
-        if scene is None:
-            continue
-        t0 = time.perf_counter()
-        rep = ncd.step(scene, h, settings=settings, init="warm")
-        wall = time.perf_counter() - t0
-        nm = scene.n_mobile
-        for key, v in (("time", rep.time), ("n_grains", nm), ("kinetic_energy", ncd.kinetic_energy(scene)),
-                       ("sweeps", rep.sweeps), ("residual", rep.residual), ("converged", rep.converged),
-                       ("n_contacts", rep.n_contacts), ("max_penetration", rep.max_penetration),
-                       ("source_height", source.height), ("wall_time", wall)):
-            rec[key].append(v)
-        if np.any((np.abs(scene.pos[:nm, 0]) > x_edge) & (scene.pos[:nm, 1] < 0)):
-            raise SimulationError(f"a grain left the ground at step {k}: enlarge ground.half_width_d")
-        if log is not None and time.perf_counter() - last_log > log_every:
-            last_log = time.perf_counter()
-            log.info("step %d, t = %.4g s: poured %d/%d, %d contacts, KE %.3g J, sweeps %d, residual %.2g, "
-                     "max penetration %.3f d, mean %.1f ms/step", k, rep.time, nm, n_target, rep.n_contacts,
-                     rec["kinetic_energy"][-1], rep.sweeps, rep.residual, rep.max_penetration / d,
-                     1e3 * np.mean(rec["wall_time"]))
-        if nm == n_target and k % c["rest_check_every"] == 0:
-            vmax = np.max(np.hypot(scene.vel[:nm, 0], scene.vel[:nm, 1]))
-            if vmax < rest_speed:
-                eq = ncd.equilibrium_test(scene, h, settings=eq_settings, init="warm",
-                                          velocity_tol=c["velocity_tol"])
-                if log is not None:
-                    log.info("step %d: max speed %.3g m/s, equilibrium test at_rest=%s (max |u_f| = %.3g g h,"
-                             " %d sweeps, residual %.2g)", k, vmax, eq.at_rest, eq.max_velocity,
-                             eq.result.sweeps, eq.result.residual)
-                if eq.at_rest:
-                    return scene, {k: np.array(v) for k, v in rec.items()}, (ground_pos, ground_radius), eq
-    raise SimulationError(f"the pile is not at rest after max_steps = {c['max_steps']} "
-                          f"(poured {scene.n_mobile if scene else 0}/{n_target})")
+    ground = make_ground(cfg, rng)
+    source = Source(cfg, rng, float(np.mean(ground[1])))
+    factory = lambda p, r, v, w, a: pile_scene(cfg, p, r, *ground, vel=v, spin=w, angle=a)  # noqa: E731
+    scene, rec, eq, frames = build(cfg, ground, source, factory, log, log_every, checkpoint, checkpoint_every,
+                                   frame_every)
+    return (scene, rec, ground, eq) + ((frames,) if frame_every > 0 else ())
 
 
 def construction_dataset(cfg, scene, rec, ground, eq):

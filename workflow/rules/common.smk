@@ -16,7 +16,7 @@ from ncd.configcheck import check_config
 ROOT = Path(workflow.basedir)
 
 # Figures in the order of the paper; each has a rules file and a config section.
-FIGURES = [f for f in ("fig1_wedged", "fig2_slope", "fig3_equilibrium", "fig4_pile",
+FIGURES = [f for f in ("fig1_wedged", "fig2_slope", "fig3_equilibrium", "fig4_pile", "fig4_history",
                        "stability", "error_vs_runtime")
            if (ROOT / "workflow" / "rules" / f"{f}.smk").exists()]
 
@@ -37,11 +37,15 @@ NCD_MODULES = {
     "fig1_wedged": ["figures/__init__.py", "figures/wedged.py"],
     "fig2_slope": ["figures/__init__.py", "figures/slope.py", "figures/slope_analysis.py"],
     "fig3_equilibrium": ["figures/__init__.py", "figures/equilibrium.py"],
-    "fig4_pile": ["figures/__init__.py", "figures/pile.py", "figures/cuts.py"],
+    "fig4_pile": ["figures/__init__.py", "figures/pile.py", "figures/cuts.py", "figures/construction.py",
+                  "figures/sources.py"],
+    "fig4_history": ["figures/__init__.py", "figures/pile.py", "figures/cuts.py", "figures/construction.py",
+                     "figures/sources.py", "figures/history.py", "figures/history_analysis.py"],
     "stability": ["studies/__init__.py", "studies/stability.py", "studies/scenes.py"],
     "error_vs_runtime": ["studies/__init__.py", "studies/work_precision.py", "studies/scenes.py"],
     "bench": ["studies/__init__.py", "studies/bench.py", "studies/peer.py", "studies/c_sweep.c",
-              "figures/__init__.py", "figures/pile.py", "figures/cuts.py"],
+              "figures/__init__.py", "figures/pile.py", "figures/cuts.py", "figures/construction.py",
+              "figures/sources.py"],
 }
 
 

@@ -1,0 +1,195 @@
+"""The construction loop of a pile (Moreau 2005, section 5), with checkpoints and frames.
+
+Grains from a source (:mod:`ncd.figures.sources`) are added every
+``source.insert_every`` steps; every step is a warm-started Moreau-Jean step
+(the antecedent impulses as initial guess, section 2); once every grain is in,
+the equilibrium test of section 2 is tried every ``rest_check_every`` steps.
+
+Checkpoint (issue 16): every ``checkpoint_every`` steps the whole state of the
+loop -- scene state (positions, angles, velocities, spins, time), the warm-start
+memory (previous contact keys and impulses), the step counter, the grains' birth
+steps, the source's height, grain counter and generator state, the per-step
+record and the stored frames -- goes to an ``.npz`` written to a temporary file
+and renamed (atomic).  A run started with an existing checkpoint of the same
+configuration resumes after its step, and ends bit for bit where an
+uninterrupted run ends.
+"""
+import json
+import os
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+import ncd
+from ncd.model import SimulationError
+from ncd.pipeline import settings as solver_settings
+
+from .sources import mean_diameter
+
+RECORD = ("time", "n_grains", "kinetic_energy", "sweeps", "residual", "converged", "n_contacts",
+          "max_penetration", "source_height", "wall_time")
+FRAME = ("x", "y", "radius", "vx", "vy", "spin")
+
+
+def _frame(scene, n_target):
+    """The mobile grains' state, padded with NaN to ``n_target`` discs."""
+    nm = scene.n_mobile
+    out = np.full((len(FRAME), n_target), np.nan)
+    out[:, :nm] = [scene.pos[:nm, 0], scene.pos[:nm, 1], scene.radius[:nm], scene.vel[:nm, 0],
+                   scene.vel[:nm, 1], scene.spin[:nm]]
+    return out
+
+
+def write_checkpoint(path, cfg, k, scene, born, source, rec, frames, frame_steps):
+    """Write the loop's state after step ``k`` to ``path`` (temporary file, then rename)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    nm = scene.n_mobile
+    data = dict(step=k, config=yaml.safe_dump(cfg, sort_keys=True), time=scene.time,
+                pos=scene.pos, vel=scene.vel, spin=scene.spin, angle=scene.angle, radius=scene.radius[:nm],
+                prev_keys=scene.prev_keys, prev_impulse=scene.prev_impulse, born=born,
+                rng_state=json.dumps(source.rng.bit_generator.state), source_state=json.dumps(source.state()),
+                frames=np.array(frames).reshape(-1, len(FRAME), cfg["grains"]["n"]),
+                frame_steps=np.array(frame_steps, np.int64),
+                **{f"rec_{key}": np.array(v) for key, v in rec.items()})
+    fd, tmp = tempfile.mkstemp(suffix=".npz.part", dir=path.parent)
+    os.close(fd)
+    try:
+        with open(tmp, "wb") as f:
+            np.savez(f, **data)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        raise
+
+
+def read_checkpoint(path, cfg):
+    """The checkpoint at ``path`` as a dict, or None if absent or of another configuration."""
+    path = Path(path)
+    if not path.exists():
+        return None
+    with np.load(path, allow_pickle=False) as z:
+        data = {k: z[k] for k in z.files}
+    if str(data["config"]) != yaml.safe_dump(cfg, sort_keys=True):
+        return None
+    return data
+
+
+def build(cfg, ground, source, scene_factory, log=None, log_every=10.0, checkpoint=None,
+          checkpoint_every=0, frame_every=0):
+    """Pour ``grains.n`` discs from ``source`` onto ``ground`` and step until at rest.
+
+    ``scene_factory(pos, radius, vel, spin, angle)`` builds a scene.  Returns
+    ``(scene, record, eq, frames)``: the final scene, the per-step record (dict of
+    arrays), the warm-started :class:`ncd.EquilibriumResult` of the final state
+    and ``(frame_steps, frames)`` with ``frames`` of shape (frame, 6, n) holding
+    :data:`FRAME` every ``frame_every`` steps (none if 0) and at the end.
+    ``checkpoint`` (a path) with ``checkpoint_every > 0`` saves and resumes.
+    """
+    c = cfg["construction"]
+    d = mean_diameter(cfg)
+    h = cfg["h"]
+    n_target = cfg["grains"]["n"]
+    settings = solver_settings(c["settings"])
+    eq_settings = solver_settings(c["equilibrium"])
+    min_age = int(np.ceil(0.5 * np.sqrt(d / cfg["gravity"]) / h))
+    rest_speed = c["rest_speed"] * np.sqrt(cfg["gravity"] * d)
+    x_edge = ground[0][:, 0].max()
+    scene = None
+    born = np.zeros(0, np.int64)
+    rec = {k: [] for k in RECORD}
+    frames, frame_steps = [], []
+    k0 = 1
+    saved = read_checkpoint(checkpoint, cfg) if checkpoint is not None and checkpoint_every > 0 else None
+    if saved is not None:
+        nm = len(saved["radius"])
+        scene = scene_factory(saved["pos"][:nm], saved["radius"], saved["vel"][:nm], saved["spin"][:nm],
+                              saved["angle"][:nm])
+        scene.pos, scene.vel, scene.spin, scene.angle = (saved[k].copy() for k in ("pos", "vel", "spin", "angle"))
+        scene.time = float(saved["time"])
+        scene.prev_keys, scene.prev_impulse = saved["prev_keys"], saved["prev_impulse"]
+        born = saved["born"]
+        source.restore(json.loads(str(saved["source_state"])), json.loads(str(saved["rng_state"])))
+        rec = {k: list(saved[f"rec_{k}"]) for k in RECORD}
+        frames, frame_steps = list(saved["frames"]), list(saved["frame_steps"])
+        k0 = int(saved["step"]) + 1
+        if log is not None:
+            log.info("resumed from checkpoint %s after step %d (%d grains)", checkpoint, k0 - 1, nm)
+    last_log = time.perf_counter()
+    for k in range(k0, c["max_steps"] + 1):
+        nm = 0 if scene is None else scene.n_mobile
+        if nm < n_target and (k - 1) % cfg["source"]["insert_every"] == 0:
+            st = (scene.pos[:nm], scene.radius[:nm], scene.vel[:nm], scene.spin[:nm], scene.angle[:nm]) \
+                if scene else (np.zeros((0, 2)), np.zeros(0), np.zeros((0, 2)), np.zeros(0), np.zeros(0))
+            source.update_height(st[0], st[1], st[2], k - born >= min_age)
+            p, r = source.draw(st[0], st[1], n_target - nm)
+            if len(r):
+                vel = np.vstack([st[2], np.tile([0.0, -source.speed], (len(r), 1))])
+                new = scene_factory(np.vstack([st[0], p]), np.concatenate([st[1], r]), vel,
+                                    np.concatenate([st[3], np.zeros(len(r))]),
+                                    np.concatenate([st[4], np.zeros(len(r))]))
+                if scene is not None:
+                    new.time = scene.time
+                    carry_warm(scene, new)
+                scene = new
+                born = np.concatenate([born, np.full(len(r), k)])
+        if scene is None:
+            continue
+        t0 = time.perf_counter()
+        rep = ncd.step(scene, h, settings=settings, init="warm")
+        wall = time.perf_counter() - t0
+        nm = scene.n_mobile
+        for key, v in zip(RECORD, (rep.time, nm, ncd.kinetic_energy(scene), rep.sweeps, rep.residual,
+                                   rep.converged, rep.n_contacts, rep.max_penetration, source.height, wall)):
+            rec[key].append(v)
+        if np.any((np.abs(scene.pos[:nm, 0]) > x_edge) & (scene.pos[:nm, 1] < 0)):
+            raise SimulationError(f"a grain left the ground at step {k}: enlarge ground.half_width_d")
+        if frame_every > 0 and k % frame_every == 0:
+            frames.append(_frame(scene, n_target))
+            frame_steps.append(k)
+        if log is not None and time.perf_counter() - last_log > log_every:
+            last_log = time.perf_counter()
+            log.info("step %d, t = %.4g s: poured %d/%d, %d contacts, KE %.3g J, sweeps %d, residual %.2g, "
+                     "max penetration %.3f d, mean %.1f ms/step", k, rep.time, nm, n_target, rep.n_contacts,
+                     rec["kinetic_energy"][-1], rep.sweeps, rep.residual, rep.max_penetration / d,
+                     1e3 * np.mean(rec["wall_time"]))
+        if nm == n_target and k % c["rest_check_every"] == 0:
+            vmax = np.max(np.hypot(scene.vel[:nm, 0], scene.vel[:nm, 1]))
+            if vmax < rest_speed:
+                eq = ncd.equilibrium_test(scene, h, settings=eq_settings, init="warm",
+                                          velocity_tol=c["velocity_tol"])
+                if log is not None:
+                    log.info("step %d: max speed %.3g m/s, equilibrium test at_rest=%s (max |u_f| = %.3g g h,"
+                             " %d sweeps, residual %.2g)", k, vmax, eq.at_rest, eq.max_velocity,
+                             eq.result.sweeps, eq.result.residual)
+                if eq.at_rest:
+                    if not frame_steps or frame_steps[-1] != k:
+                        frames.append(_frame(scene, n_target))
+                        frame_steps.append(k)
+                    return (scene, {key: np.array(v) for key, v in rec.items()}, eq,
+                            (np.array(frame_steps, np.int64), np.array(frames).reshape(-1, len(FRAME), n_target)))
+        if checkpoint is not None and checkpoint_every > 0 and k % checkpoint_every == 0 and scene is not None:
+            write_checkpoint(checkpoint, cfg, k, scene, born, source, rec, frames, frame_steps)
+    raise SimulationError(f"the pile is not at rest after max_steps = {c['max_steps']} "
+                          f"(poured {scene.n_mobile if scene else 0}/{n_target})")
+
+
+def carry_warm(old, new):
+    """Give ``new`` (``old`` plus grains appended after its mobile discs) the warm-start
+    memory of ``old``: the body-pair keys are re-encoded for the new disc count."""
+    from ncd.contacts import pair_key
+    if old.prev_keys is None or len(old.prev_keys) == 0:
+        return
+    base = old.n_disc + 1024   # the key layout of ncd.contacts.pair_key
+    a, b = np.divmod(old.prev_keys, base)
+    added = new.n_mobile - old.n_mobile
+    b = np.where(b >= old.n_mobile, b + added, b)      # obstacles (and walls) shift
+    b_new = np.where(b >= new.n_disc, -1 - (b - new.n_disc), b)
+    keys = pair_key(a, b_new, new.n_disc)
+    order = np.argsort(keys, kind="stable")
+    new.prev_keys = keys[order]
+    new.prev_impulse = old.prev_impulse[order]

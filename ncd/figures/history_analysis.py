@@ -1,0 +1,168 @@
+"""Ground pressure and arching over ensembles of piles of two histories (issue 16).
+
+Per pile (history forces: the warm-started equilibrium test of its final state):
+
+* ground stress profile ``p(xi)``, ``xi = x / L`` (``L`` the pile's base half-width,
+  ``x = 0`` the source axis): a Gaussian kernel average of the vertical forces of
+  the ground contacts, standard deviation ``w`` mean diameters, normalised by the
+  mean ground stress ``W / (2 L)`` (``W`` the weight), so ``p = 1`` is the weight
+  spread evenly over the base;
+* dip depth ``(M - m) / M``: ``m`` the central minimum of ``p`` (``|xi| <= dip_center``),
+  ``M`` the mean of the largest ``p`` on either side within ``dip_flank``: > 0 a dip
+  under the apex, < 0 a hump;
+* arching: the resultant across vertical cuts at ``x = ± q L`` (whole column,
+  :func:`ncd.figures.cuts.cut_matrix`), its angle below the horizontal and its
+  deviation from the pile's own flank slope (:func:`ncd.figures.cuts.flank_angles`).
+
+Ensemble statistics resample *piles* (never runs of one pile): the mean profile with
+a percentile bootstrap band, the dip of the mean profile with its band, the
+difference of the histories with a bootstrap band and a permutation p-value
+(history labels shuffled among the piles).
+"""
+import numpy as np
+import xarray as xr
+
+from . import cuts as cm
+from .history import HISTORIES, ground_forces
+from .pile import equilibrium_problem, final_scene
+from .sources import mean_diameter
+
+
+def stress_profile(x, fy, weight, L, xi, width):
+    """Kernel-averaged ground stress at ``xi`` (units of ``W / (2 L)``); ``width`` in m."""
+    s = width / L
+    k = np.exp(-0.5 * ((xi[:, None] - x[None, :] / L) / s) ** 2) / (np.sqrt(2 * np.pi) * s)
+    return 2.0 * (k @ fy) / weight
+
+
+def dip_depth(profile, xi, center, flank):
+    """``(M - m) / M`` along the last axis: ``m`` the central minimum (``|xi| <= center``),
+    ``M`` the mean of the largest values on either side within ``flank``."""
+    P = np.reshape(profile, (-1, len(xi)))
+    a = np.abs(xi)
+    m = np.min(P[:, a <= center], axis=1)
+    sel = (a >= flank[0]) & (a <= flank[1])
+    big = 0.5 * (np.max(P[:, sel & (xi < 0)], axis=1) + np.max(P[:, sel & (xi > 0)], axis=1))
+    return ((big - m) / big).reshape(np.shape(profile)[:-1])
+
+
+def pile_measures(cfg, ds):
+    """The measures of one pile file (see the module docstring)."""
+    a = cfg["analysis"]
+    d = mean_diameter(cfg)
+    L = float(ds.attrs["base_half_width"])
+    W = float(ds.attrs["weight"])
+    xi = np.linspace(-a["xi_max"], a["xi_max"], a["n_xi"])
+    x, fx, fy = ground_forces(ds)
+    prof = np.array([stress_profile(x, fy, W, L, xi, w * d) for w in a["kernel_d"]])
+    scene = final_scene(cfg, ds)
+    problem = equilibrium_problem(cfg, scene, ds)
+    nm = scene.n_mobile
+    forces = np.column_stack([ds["force_n"].values, ds["force_t"].values]).ravel()
+    q = np.asarray(a["cut_positions"], float)
+    specs = [(s * qq * L, s, -np.inf, np.inf) for s in (-1, 1) for qq in q]
+    C, counts = cm.cut_matrix(problem.contacts, scene.pos, nm, specs)
+    F = (C @ forces).reshape(-1, 2)
+    outer = np.repeat([-1, 1], len(q))
+    slope = np.where(outer > 0, ds.attrs["right_angle"], ds.attrs["left_angle"])
+    phi, dev = cm.flank_angles(F[:, 0], F[:, 1], outer, slope)
+    return dict(xi=xi, profile=prof, ground_fx=float(fx.sum()), ground_fy=float(fy.sum()), weight=W,
+                base_half_width=L, n_ground=len(x), cut_angle=phi.reshape(2, -1), cut_deviation=dev.reshape(2, -1),
+                cut_count=np.asarray(counts).reshape(2, -1), surface_angle=slope.reshape(2, -1),
+                dip=dip_depth(prof, xi, a["dip_center"], a["dip_flank"]))
+
+
+def bootstrap_index(rng, n_piles, n_boot):
+    """``(n_boot, n_piles)`` resampled pile indices."""
+    return rng.integers(0, n_piles, size=(n_boot, n_piles))
+
+
+def permutation_p(dip_a, dip_b, profiles_a, profiles_b, xi, center, flank, rng, n_perm):
+    """Two-sided permutation p-value of the difference of the dips of the mean profiles
+    (history labels shuffled among the piles)."""
+    both = np.concatenate([profiles_a, profiles_b])
+    na = len(profiles_a)
+    obs = dip_a - dip_b
+    count = 0
+    for _ in range(n_perm):
+        idx = rng.permutation(len(both))
+        da = dip_depth(both[idx[:na]].mean(axis=0), xi, center, flank)
+        db = dip_depth(both[idx[na:]].mean(axis=0), xi, center, flank)
+        count += abs(da - db) >= abs(obs) - 1e-15
+    return (count + 1) / (n_perm + 1)
+
+
+def ensemble_dataset(cfg, files):
+    """analysis.nc from ``files = {history: [pile datasets in member order]}``."""
+    a = cfg["analysis"]
+    hist = [h for h in HISTORIES if h in files]
+    per = {h: [pile_measures(cfg, ds) for ds in files[h]] for h in hist}
+    n = min(len(v) for v in per.values())
+    if any(len(v) != n for v in per.values()):
+        raise ValueError(f"histories have different pile counts: { {h: len(v) for h, v in per.items()} }")
+    xi = per[hist[0]][0]["xi"]
+    widths = np.asarray(a["kernel_d"], float)
+    stack = lambda key: np.array([[m[key] for m in per[h]] for h in hist])  # noqa: E731
+    prof = stack("profile")                       # (history, pile, width, xi)
+    dips = stack("dip")                           # (history, pile, width)
+    rng = np.random.default_rng(a["seed"])
+    B, lo, hi = a["bootstrap"], 0.5 * (1 - a["level"]), 0.5 * (1 + a["level"])
+    idx = bootstrap_index(rng, n, B)              # the same resamples for both histories
+    boot_mean = prof[:, idx].mean(axis=2)         # (history, B, width, xi)
+    boot_dip = dip_depth(boot_mean, xi, a["dip_center"], a["dip_flank"])           # (history, B, width)
+    mean = prof.mean(axis=1)
+    dip_mean = dip_depth(mean, xi, a["dip_center"], a["dip_flank"])                # (history, width)
+    idx2 = bootstrap_index(rng, n, B)             # independent resamples of the second history
+    diff_boot = boot_dip[0] - dip_depth(prof[-1][idx2].mean(axis=1), xi, a["dip_center"], a["dip_flank"])
+    p_value = np.array([permutation_p(dip_mean[0, j], dip_mean[-1, j], prof[0, :, j], prof[-1, :, j], xi,
+                                      a["dip_center"], a["dip_flank"], rng, a["permutations"]) for j in range(len(widths))])
+    dev = stack("cut_deviation")                  # (history, pile, flank, position)
+    ang = stack("cut_angle")
+    q = np.asarray(a["cut_positions"], float)
+    boot_med = np.median(dev[:, idx], axis=2)     # (history, B, flank, position)
+    one = lambda dims, v, u, ln: (dims, v, {"units": u, "long_name": ln})  # noqa: E731
+    H, P, K, X, F, Q = "history", "pile", "kernel", "xi", "flank", "cut_position"
+    out = xr.Dataset(
+        {
+            "profile": one((H, P, K, X), prof, "1", "ground stress / (weight / base width), per pile"),
+            "profile_mean": one((H, K, X), mean, "1", "mean ground stress over piles / (weight / base width)"),
+            "profile_lo": one((H, K, X), np.quantile(boot_mean, lo, axis=1), "1",
+                              "bootstrap band over piles of the mean ground stress, lower end"),
+            "profile_hi": one((H, K, X), np.quantile(boot_mean, hi, axis=1), "1",
+                              "bootstrap band over piles of the mean ground stress, upper end"),
+            "dip": one((H, P, K), dips, "1", "dip depth of one pile's profile (M - m) / M"),
+            "dip_mean": one((H, K), dip_mean, "1", "dip depth of the mean profile (M - m) / M"),
+            "dip_lo": one((H, K), np.quantile(boot_dip, lo, axis=1), "1", "bootstrap band of dip_mean, lower"),
+            "dip_hi": one((H, K), np.quantile(boot_dip, hi, axis=1), "1", "bootstrap band of dip_mean, upper"),
+            "dip_diff": one((K,), dip_mean[0] - dip_mean[-1], "1", f"dip_mean {hist[0]} minus {hist[-1]}"),
+            "dip_diff_lo": one((K,), np.quantile(diff_boot, lo, axis=0), "1", "bootstrap band of dip_diff, lower"),
+            "dip_diff_hi": one((K,), np.quantile(diff_boot, hi, axis=0), "1", "bootstrap band of dip_diff, upper"),
+            "dip_diff_p": one((K,), p_value, "1", "two-sided permutation p-value of dip_diff (labels over piles)"),
+            "cut_deviation": one((H, P, F, Q), dev, "degree", "cut resultant angle minus free-surface slope"),
+            "cut_angle": one((H, P, F, Q), ang, "degree", "cut resultant angle below the horizontal, outward"),
+            "cut_count": one((H, P, F, Q), stack("cut_count"), "1", "contacts crossing the cut"),
+            "deviation_median": one((H, F, Q), np.median(dev, axis=1), "degree",
+                                    "median over piles of the cut deviation"),
+            "deviation_q25": one((H, F, Q), np.quantile(dev, 0.25, axis=1), "degree",
+                                 "25th percentile over piles of the cut deviation"),
+            "deviation_q75": one((H, F, Q), np.quantile(dev, 0.75, axis=1), "degree",
+                                 "75th percentile over piles of the cut deviation"),
+            "deviation_median_lo": one((H, F, Q), np.quantile(boot_med, lo, axis=1), "degree",
+                                       "bootstrap band over piles of the median deviation, lower"),
+            "deviation_median_hi": one((H, F, Q), np.quantile(boot_med, hi, axis=1), "degree",
+                                       "bootstrap band over piles of the median deviation, upper"),
+            "surface_angle": one((H, P, F), stack("surface_angle")[..., 0], "degree", "flank slope of the pile"),
+            "base_half_width": one((H, P), stack("base_half_width"), "m", "base half-width L of the pile"),
+            "weight": one((H, P), stack("weight"), "N", "weight of the pile"),
+            "ground_fx": one((H, P), stack("ground_fx"), "N", "horizontal ground reaction"),
+            "ground_fy": one((H, P), stack("ground_fy"), "N", "vertical ground reaction"),
+            "n_ground": one((H, P), stack("n_ground"), "1", "ground contacts"),
+        },
+        coords={H: hist, P: np.arange(n), K: widths, X: xi, F: ["left", "right"], Q: q},
+        attrs={"level": a["level"], "bootstrap": B, "permutations": a["permutations"],
+               "dip_center": a["dip_center"], "dip_flank": list(a["dip_flank"]), "mean_diameter": mean_diameter(cfg)},
+    )
+    out[K].attrs.update(units="1", long_name="kernel standard deviation in mean grain diameters")
+    out[X].attrs.update(units="1", long_name="x / base half-width")
+    out[Q].attrs.update(units="1", long_name="cut position |x| / base half-width")
+    return out

@@ -1,0 +1,115 @@
+"""Grain sources of a pile construction (Moreau 2005, section 5; issue 16).
+
+Two construction histories of the same grains onto the same rough ground:
+
+* :class:`PointSource` -- a localized source above the axis ``x = 0`` that rises
+  with the pile (Figure 4's pile; Vanel et al. 1999 and Geng et al. 2001 find a
+  pressure dip under the apex of such piles);
+* :class:`RainSource` -- the grains rained uniformly over ``|x| <= half_width``
+  (the final base half-width of the point-source pile), from a height that
+  rises with the deposit (such piles show a pressure hump in those experiments).
+
+Both expose ``update_height(pos, radius, vel, age_ok)``, ``draw(pos, radius, limit)``
+and the state a checkpoint needs (``height``, ``taken`` and the generator ``rng``).
+When ``radii`` is given the grains are taken in that order (the same grains for
+both histories); otherwise each radius is drawn from ``rng`` when its site is
+tried (Figure 4's original pile, kept bit for bit).
+"""
+import numpy as np
+
+
+def mean_diameter(cfg):
+    """Mean diameter of the grains (radii uniform in ``[radius_min, radius_max]``)."""
+    return cfg["grains"]["radius_min"] + cfg["grains"]["radius_max"]
+
+
+class _Source:
+    """Common part: grain sizes, drop height above the settled grains, inlet speed."""
+
+    def __init__(self, cfg, rng, y_ground, half_span, radii=None):
+        s = cfg["source"]
+        g = cfg["grains"]
+        self.cfg, self.rng, self.d = s, rng, mean_diameter(cfg)
+        self.rmin, self.rmax = g["radius_min"], g["radius_max"]
+        self.radii = None if radii is None else np.asarray(radii, float)
+        self.taken = 0                      # grains already inserted from ``radii``
+        self.half_span = half_span          # settled grains within this |x| (plus d) set the height
+        self.speed = s["inlet_speed"] * np.sqrt(cfg["gravity"] * self.d)
+        self.height = y_ground + (s["drop_height_d"] + 0.5) * self.d
+        self.settle_speed = 0.2 * np.sqrt(cfg["gravity"] * self.d)
+
+    def update_height(self, pos, radius, vel, age_ok):
+        """Raise the source above the settled grains within one diameter of its span
+        (the height never decreases)."""
+        near = (np.abs(pos[:, 0]) < self.half_span + self.d) & age_ok
+        near &= np.hypot(vel[:, 0], vel[:, 1]) < self.settle_speed
+        if near.any():
+            top = float(np.max(pos[near, 1] + radius[near]))
+            self.height = max(self.height, top + (self.cfg["drop_height_d"] + 0.5) * self.d)
+
+    def _radius(self):
+        return self.rng.uniform(self.rmin, self.rmax) if self.radii is None else self.radii[self.taken]
+
+    def _try(self, x, r, pos, radius, new_p, new_r):
+        """Insert a grain of radius ``r`` at ``(x, height)`` if it clears every grain by 0.05 d."""
+        clear = 0.05 * self.d
+        p = np.array([x, self.height])
+        ok = len(radius) == 0 or np.min(np.hypot(*(pos - p).T) - radius - r) > clear
+        ok = ok and all(np.hypot(*(q - p)) > r + rq + clear for q, rq in zip(new_p, new_r))
+        if ok:
+            new_p.append(p)
+            new_r.append(r)
+            if self.radii is not None:
+                self.taken += 1
+        return ok
+
+    def state(self):
+        """What a checkpoint stores (besides the generator)."""
+        return {"height": self.height, "taken": self.taken}
+
+    def restore(self, state, rng_state):
+        self.height, self.taken = float(state["height"]), int(state["taken"])
+        self.rng.bit_generator.state = rng_state
+
+
+class PointSource(_Source):
+    """A localized source above the pile axis ``x = 0``: ``slots`` insertion sites in a
+    row, ``drop_height_d`` mean diameters above the settled grains under it (so that
+    impacts stay gentle while the pile grows)."""
+
+    def __init__(self, cfg, rng, y_ground, radii=None):
+        s = cfg["source"]
+        g = cfg["grains"]
+        pitch = 2.2 * g["radius_max"]
+        super().__init__(cfg, rng, y_ground, 0.5 * s["slots"] * pitch, radii)
+        self.slots = (np.arange(s["slots"]) - (s["slots"] - 1) / 2) * pitch
+        self.half_width = self.half_span
+
+    def draw(self, pos, radius, limit):
+        """New grains at free sites (clearance ``0.05 d``): positions and radii."""
+        new_p, new_r = [], []
+        for x in self.slots[self.rng.permutation(len(self.slots))]:
+            if len(new_r) >= limit:
+                break
+            r = self._radius()
+            self._try(x + self.rng.uniform(-1, 1) * self.cfg["jitter_d"] * self.d, r, pos, radius, new_p, new_r)
+        return np.array(new_p).reshape(-1, 2), np.array(new_r)
+
+
+class RainSource(_Source):
+    """Rain over ``|x| <= half_width``: ``sites`` positions drawn uniformly per attempt,
+    at ``drop_height_d`` above the highest settled grain under the rain."""
+
+    def __init__(self, cfg, rng, y_ground, half_width, sites, radii=None):
+        if not (np.isfinite(half_width) and half_width > 0):
+            raise ValueError(f"rain half_width = {half_width!r} must be > 0")
+        super().__init__(cfg, rng, y_ground, float(half_width), radii)
+        self.half_width, self.sites = float(half_width), int(sites)
+
+    def draw(self, pos, radius, limit):
+        new_p, new_r = [], []
+        for x in self.rng.uniform(-self.half_width, self.half_width, self.sites):
+            if len(new_r) >= limit:
+                break
+            self._try(x, self._radius(), pos, radius, new_p, new_r)
+        return np.array(new_p).reshape(-1, 2), np.array(new_r)

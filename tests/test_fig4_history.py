@@ -1,0 +1,186 @@
+"""Issue 16: piles of two construction histories, checkpoint/restart, ensemble statistics.
+
+Unit tests on small piles and hand-made profiles, then checks on the figure data
+of a whole-DAG run (fixture ``results``).
+"""
+import glob
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+import yaml
+
+import ncd
+from ncd.figures import construction, history
+from ncd.figures import history_analysis as ha
+
+ROOT = Path(__file__).resolve().parent.parent
+WEIGHT_TOL = 1e-9            # every pile: vertical ground reaction vs weight (relative)
+
+
+class Killed(Exception):
+    """Injected into a construction step: the run dies there."""
+
+
+def small_cfg(n=40):
+    cfg = yaml.safe_load(open(ROOT / "config.yaml"))["fig4_history"]
+    cfg["grains"]["n"] = n
+    cfg["ground"]["half_width_d"] = 20
+    cfg["construction"].update(checkpoint_every=40, frame_every=50)
+    return cfg
+
+
+@pytest.fixture(scope="module")
+def uninterrupted():
+    cfg = small_cfg()
+    return cfg, history.construct(cfg, "point", 3)
+
+
+def _same(a, b):
+    sa, ra, _, ea, fa = a
+    sb, rb, _, eb, fb = b
+    for k in ("pos", "vel", "spin", "angle", "prev_keys", "prev_impulse"):
+        assert np.array_equal(getattr(sa, k), getattr(sb, k)), k
+    assert sa.time == sb.time
+    assert np.array_equal(ea.forces, eb.forces)
+    for k in ra:
+        if k != "wall_time":            # a measurement
+            assert np.array_equal(ra[k], rb[k]), k
+    assert np.array_equal(fa[0], fb[0]) and np.array_equal(fa[1], fb[1], equal_nan=True)
+
+
+def test_restart_after_a_kill_is_bit_identical(uninterrupted, tmp_path, monkeypatch):
+    cfg, ref = uninterrupted
+    n_steps = len(ref[1]["time"])
+    assert n_steps > 150
+    ckpt = tmp_path / "point_3.npz"
+    calls = {"n": 0, "kill_at": 130}
+    real_step = ncd.step
+
+    def dying_step(*args, **kw):          # the first run is killed during its step 130
+        calls["n"] += 1
+        if calls["n"] == calls["kill_at"]:
+            raise Killed("killed")
+        return real_step(*args, **kw)
+
+    monkeypatch.setattr(ncd, "step", dying_step)
+    with pytest.raises(Killed):
+        history.construct(cfg, "point", 3, checkpoint=ckpt)
+    saved = np.load(ckpt)
+    assert int(saved["step"]) == 120          # the last checkpoint (every 40 steps) before the kill
+    calls.update(n=0, kill_at=-1)
+    again = history.construct(cfg, "point", 3, checkpoint=ckpt)
+    assert calls["n"] == n_steps - 120        # resumed after step 120, not restarted
+    _same(ref, again)
+    assert ref[4][1].shape[1:] == (6, cfg["grains"]["n"])
+
+
+def test_checkpoint_of_another_configuration_is_ignored(uninterrupted, tmp_path):
+    cfg, ref = uninterrupted
+    other = small_cfg()
+    other["mu"] = 0.4
+    ckpt = tmp_path / "c.npz"
+    construction.write_checkpoint(ckpt, other, 1, ref[0], np.zeros(0, int), history.PointSource(
+        other, np.random.default_rng(0), 0.0), {k: [] for k in construction.RECORD}, [], [])
+    assert construction.read_checkpoint(ckpt, {**cfg, "history": "point", "member": 3,
+                                               "rain_half_width": None}) is None
+
+
+def test_pile_at_rest_and_weight(uninterrupted):
+    cfg, (scene, rec, ground, eq, frames) = uninterrupted
+    assert eq.at_rest and eq.max_velocity <= cfg["construction"]["velocity_tol"]
+    ds = history.pile_dataset(cfg, "point", 3, scene, rec, ground, eq, frames)
+    x, fx, fy = history.ground_forces(ds)
+    assert abs(fy.sum() / ds.attrs["weight"] - 1) < WEIGHT_TOL
+    assert abs(fx.sum()) / ds.attrs["weight"] < WEIGHT_TOL
+    # the last frame is the final state; earlier frames hold fewer grains (NaN padding)
+    assert np.array_equal(ds.frame_x.values[-1], ds.x.values)
+    assert np.isnan(ds.frame_x.values[0]).any()
+
+
+def test_rain_source_and_same_grains():
+    cfg = small_cfg(30)
+    r1, r2 = history.grain_radii(cfg, 5), history.grain_radii(cfg, 5)
+    assert np.array_equal(r1, r2) and not np.array_equal(r1, history.grain_radii(cfg, 6))
+    src = history.RainSource(cfg, np.random.default_rng(1), 0.0, 0.01, 50, r1)
+    p, r = src.draw(np.zeros((0, 2)), np.zeros(0), 30)
+    assert len(r) > 5 and np.all(np.abs(p[:, 0]) <= 0.01)
+    assert np.array_equal(r, r1[:len(r)])           # taken in order
+    with pytest.raises(ValueError, match="rain_half_width"):
+        history.construct(cfg, "rain", 0)
+    with pytest.raises(ValueError, match="history"):
+        history.construct(cfg, "sieve", 0)
+
+
+def test_profile_and_dip_by_hand():
+    xi = np.linspace(-1.3, 1.3, 261)
+    # one contact carrying the weight at x = 0: the profile integrates to 2 (mean 1 over |xi| <= 1)
+    p = ha.stress_profile(np.array([0.0]), np.array([3.0]), 3.0, 2.0, xi, 0.1)
+    assert np.sum(0.5 * (p[1:] + p[:-1]) * np.diff(xi)) == pytest.approx(2.0, rel=1e-6)
+    dip = 1 - 0.3 * np.exp(-(xi / 0.2) ** 2)                 # 30 % dip at the centre
+    hump = 1 + 0.5 * np.exp(-(xi / 0.3) ** 2)
+    d = ha.dip_depth(np.array([dip, hump]), xi, 0.1, (0.25, 0.7))
+    assert d[0] == pytest.approx(0.3, abs=1e-3)
+    assert d[1] < -0.1
+
+
+def test_permutation_detects_a_difference_and_not_a_null():
+    rng = np.random.default_rng(0)
+    xi = np.linspace(-1.3, 1.3, 131)
+    base = 1 - 0.3 * np.exp(-(xi / 0.2) ** 2)
+    a = base + 0.05 * rng.standard_normal((12, len(xi)))
+    b = 1 + 0.3 * np.exp(-(xi / 0.2) ** 2) + 0.05 * rng.standard_normal((12, len(xi)))
+    da, db = (ha.dip_depth(v.mean(axis=0), xi, 0.1, (0.25, 0.7)) for v in (a, b))
+    assert ha.permutation_p(da, db, a, b, xi, 0.1, (0.25, 0.7), rng, 300) < 0.01
+    c = base + 0.05 * rng.standard_normal((12, len(xi)))
+    dc = ha.dip_depth(c.mean(axis=0), xi, 0.1, (0.25, 0.7))
+    assert ha.permutation_p(da, dc, a, c, xi, 0.1, (0.25, 0.7), rng, 300) > 0.05
+
+
+# ------------------------------------------------------------------ figure data
+@pytest.fixture(scope="module")
+def piles(results):
+    paths = sorted(glob.glob(str(results / "fig4_history" / "piles" / "n*" / "*.nc")))
+    assert paths, "no pile files"
+    return [xr.load_dataset(p) for p in paths]
+
+
+@pytest.fixture(scope="module")
+def analysis(results):
+    (path,) = glob.glob(str(results / "fig4_history" / "analysis_n*.nc"))
+    return xr.load_dataset(path)
+
+
+def test_every_pile_at_rest_and_carried_by_the_ground(piles):
+    for ds in piles:
+        assert ds.attrs["at_rest"] == 1 and ds.attrs["eq_converged"] == 1
+        x, fx, fy = history.ground_forces(ds)
+        assert abs(fy.sum() / ds.attrs["weight"] - 1) < WEIGHT_TOL, (ds.attrs["history"], ds.attrs["member"])
+
+
+def test_histories_use_the_same_grains(piles):
+    by = {(ds.attrs["history"], ds.attrs["member"]): ds for ds in piles}
+    members = sorted({m for _, m in by})
+    assert len(members) >= 2
+    for m in members:
+        p, r = by[("point", m)], by[("rain", m)]
+        assert p.sizes["grain"] == r.sizes["grain"]
+        assert np.array_equal(p.radius.values, r.radius.values)   # same grains, same insertion order
+        assert np.array_equal(p.ground_radius.values, r.ground_radius.values)
+
+
+def test_bands_are_over_piles(analysis, piles, results):
+    cfg = yaml.safe_load(analysis.attrs["config_yaml"])
+    n = cfg["piles"]
+    assert analysis.sizes["pile"] == n and len(piles) == 2 * n
+    # the mean profile is the mean of the per-pile profiles, and the band is the bootstrap over piles
+    np.testing.assert_allclose(analysis.profile_mean, analysis.profile.mean("pile"), rtol=1e-12)
+    rng = np.random.default_rng(cfg["analysis"]["seed"])
+    idx = ha.bootstrap_index(rng, n, cfg["analysis"]["bootstrap"])
+    boot = analysis.profile.values[:, idx].mean(axis=2)
+    np.testing.assert_allclose(analysis.profile_lo, np.quantile(boot, 0.025, axis=1), rtol=1e-12)
+    # piles differ, so the band has a width
+    assert float((analysis.profile_hi - analysis.profile_lo).max()) > 0.01
+    assert np.all(analysis.profile_lo <= analysis.profile_mean + 1e-12)
+    np.testing.assert_allclose(analysis.ground_fy / analysis.weight, 1.0, atol=WEIGHT_TOL)

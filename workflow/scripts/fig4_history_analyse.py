@@ -1,0 +1,22 @@
+"""Issue 16: ground stress, dip and arching over the piles of both histories (analysis_n<n>.nc)."""
+import xarray as xr
+
+from ncd.figures import history_analysis
+from ncd.io import provenance, write_dataset
+from ncd.pipeline import start
+
+log = start(snakemake)  # noqa: F821 (snakemake is injected)
+cfg = snakemake.params.config  # noqa: F821
+files = {}
+for path in snakemake.input.piles:  # noqa: F821
+    ds = xr.load_dataset(path)
+    files.setdefault(ds.attrs["history"], []).append(ds)
+out = history_analysis.ensemble_dataset(cfg, files)
+out.attrs.update(provenance(cfg))
+write_dataset(out, snakemake.output[0])  # noqa: F821
+for h in out.history.values:
+    k = out.kernel.values[0]
+    s = out.sel(history=h, kernel=k)
+    log.info("%s: dip of the mean profile %.3f [%.3f, %.3f] (kernel %.1f d)", h, float(s.dip_mean),
+             float(s.dip_lo), float(s.dip_hi), k)
+log.info("difference %s", out.dip_diff.values)
