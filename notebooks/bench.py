@@ -55,13 +55,10 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 from IPython.display import display, Markdown
 
-try:
-    snakemake  # noqa: B018 (injected by Snakemake's notebook directive)
-except NameError:  # run by hand on the results of a finished run
-    from types import SimpleNamespace
-    snakemake = SimpleNamespace(
-        input=SimpleNamespace(**{k: f"../results/bench/{k}.nc" for k in ("core", "sweeps", "ensemble", "peer", "rules")}),
-        output=SimpleNamespace(png="bench.png", pdf="bench.pdf"))
+from ncd.notebook import paths, save
+
+# Snakemake's object, or by hand (from the repository or notebooks/) the files under results/
+snakemake = paths("bench", ["core", "sweeps", "ensemble", "peer", "rules"], globals().get("snakemake"))
 
 core = xr.load_dataset(snakemake.input.core)
 sweeps = xr.load_dataset(snakemake.input.sweeps)
@@ -233,5 +230,4 @@ ax.set_xlabel("s")
 ax.set_title("(d) slowest rules of the figures' run")
 ax.tick_params(axis="y", labelsize=7)
 fig.tight_layout()
-fig.savefig(snakemake.output.png, dpi=120)
-fig.savefig(snakemake.output.pdf)
+save(fig, snakemake.output, dpi=120, show=True)

@@ -59,14 +59,10 @@ import matplotlib.pyplot as plt
 import matplotlib.ticker
 from IPython.display import display, Markdown
 
-try:
-    snakemake  # noqa: B018 (injected by Snakemake's notebook directive)
-except NameError:  # run by hand on the results of a finished run
-    from types import SimpleNamespace
-    snakemake = SimpleNamespace(
-        input=SimpleNamespace(nlgs="../results/error_vs_runtime/nlgs.nc",
-                              integration="../results/error_vs_runtime/integration.nc"),
-        output=SimpleNamespace(png="error_vs_runtime.png", pdf="error_vs_runtime.pdf"))
+from ncd.notebook import paths, save
+
+# Snakemake's object, or by hand (from the repository or notebooks/) the files under results/
+snakemake = paths("error_vs_runtime", ["nlgs", "integration"], globals().get("snakemake"))
 
 nl = xr.load_dataset(snakemake.input.nlgs)
 it = xr.load_dataset(snakemake.input.integration)
@@ -193,8 +189,7 @@ check0 = slope0[slope0.method == "CD_reference_check"]
 integration_panel(axes[2, 3], slope0, f"(l) slope flow at {angle0:g} deg: mean velocity at T",
                   "|v - v_ref| / v_ref", reference_band=float(check0.error.iloc[0]) if len(check0) else None)
 fig.tight_layout()
-fig.savefig(snakemake.output.png, dpi=100)
-fig.savefig(snakemake.output.pdf)
+save(fig, snakemake.output, dpi=100, show=True)
 
 # %% [markdown]
 # ## Verdicts (computed from the data above)

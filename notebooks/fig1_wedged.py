@@ -52,13 +52,12 @@ from IPython.display import Image, display
 
 from ncd.figures.wedged import Wedge
 
-try:
-    paths = {k: Path(str(getattr(snakemake.input, k))) for k in ("ensemble", "evolutions", "sweep")}  # noqa: F821
-    out_png, out_pdf = Path(snakemake.output.png), Path(snakemake.output.pdf)  # noqa: F821
-except NameError:  # run by hand from the repository: use the results of `snakemake -j2 fig1_wedged`
-    root = Path.cwd() if (Path.cwd() / "results").exists() else Path.cwd().parent
-    paths = {k: root / "results" / "fig1_wedged" / f"{k}.nc" for k in ("ensemble", "evolutions", "sweep")}
-    out_png, out_pdf = root / "results/figures/fig1_wedged.png", root / "results/figures/fig1_wedged.pdf"
+from ncd.notebook import paths as notebook_paths, save
+
+# Snakemake's object, or by hand (from the repository or notebooks/) the files under results/
+_smk = notebook_paths("fig1_wedged", ["ensemble", "evolutions", "sweep"], globals().get("snakemake"))
+paths = {k: Path(str(getattr(_smk.input, k))) for k in ("ensemble", "evolutions", "sweep")}
+out_png, out_pdf = Path(_smk.output.png), Path(_smk.output.pdf)
 ens = xr.load_dataset(paths["ensemble"])
 evo = xr.load_dataset(paths["evolutions"])
 swp = xr.load_dataset(paths["sweep"])
@@ -311,8 +310,7 @@ ax.set_ylabel("fraction of wedged outcomes")
 ax.set_title("(f) threshold sweep", fontsize=10)
 ax.legend(fontsize=8, loc="upper left")
 out_png.parent.mkdir(parents=True, exist_ok=True)
-fig.savefig(out_png, dpi=130)
-fig.savefig(out_pdf)
+save(fig, _smk.output, dpi=130)
 plt.close(fig)
 display(Image(filename=str(out_png)))
 

@@ -58,18 +58,11 @@ from matplotlib.patches import Circle
 
 from ncd.figures import slope_analysis as sa
 
-try:
-    snakemake  # noqa: F821 (injected by Snakemake's notebook directive)
-    inp, out, cfg = snakemake.input, snakemake.output, snakemake.params.config  # noqa: F821
-except NameError:  # interactive use, from the repository root after `snakemake -j2 fig2_slope`
-    import yaml
-    from types import SimpleNamespace
+from ncd.notebook import paths, save
 
-    _all = yaml.safe_load(open("config.yaml"))
-    cfg = _all["fig2_slope"]
-    inp = SimpleNamespace(trajectory="results/fig2_slope/trajectory.nc",
-                          ensemble="results/fig2_slope/ensemble.nc", measures="results/fig2_slope/measures.nc")
-    out = SimpleNamespace(png="results/figures/fig2_slope.png", pdf="results/figures/fig2_slope.pdf")
+# Snakemake's object, or by hand (from the repository or notebooks/) the files under results/
+_smk = paths("fig2_slope", ["trajectory", "ensemble", "measures"], globals().get("snakemake"))
+inp, out, cfg = _smk.input, _smk.output, _smk.params.config
 
 traj = xr.load_dataset(inp.trajectory)
 ens = xr.load_dataset(inp.ensemble)
@@ -396,8 +389,7 @@ a.set_xlabel("NLGS tolerance (relative natural-map residual)")
 a.set_ylabel("spread (m/s$^2$)")
 a.set_title(f"(d) spread against tolerance: {verdict}", fontsize=9)
 a.legend(fontsize=7)
-fig.savefig(out.png, dpi=150)
-fig.savefig(out.pdf)
+save(fig, out, dpi=150)
 
 # %% [markdown]
 # ## What we measured, and where the reproduction differs

@@ -52,20 +52,11 @@ from matplotlib.patches import Circle
 from ncd.figures import equilibrium as fe
 from ncd.polytope import outside_distance
 
-try:
-    snakemake  # noqa: F821 (injected by Snakemake's notebook directive)
-    inp, out, cfg = snakemake.input, snakemake.output, snakemake.params.config  # noqa: F821
-except NameError:  # interactive use, from the repository root after `snakemake -j2 fig3_equilibrium`
-    import yaml
+from ncd.notebook import paths, save
 
-    class _P(dict):
-        __getattr__ = dict.__getitem__
-
-    d = "results/fig3_equilibrium"
-    inp = _P(state=f"{d}/state.nc", ensemble=f"{d}/ensemble.nc", projection=f"{d}/projection.nc",
-             uniform=f"{d}/uniform.nc")
-    out = _P(png="results/figures/fig3_equilibrium.png", pdf="results/figures/fig3_equilibrium.pdf")
-    cfg = yaml.safe_load(open("config.yaml"))["fig3_equilibrium"]
+# Snakemake's object, or by hand (from the repository or notebooks/) the files under results/
+_smk = paths("fig3_equilibrium", ["state", "ensemble", "projection", "uniform"], globals().get("snakemake"))
+inp, out, cfg = _smk.input, _smk.output, _smk.params.config
 
 state = xr.load_dataset(inp.state)
 ens = xr.load_dataset(inp.ensemble)
@@ -274,8 +265,7 @@ for j, k in enumerate(shown):
             ax.set_xlabel("r_t (mN)", fontsize=8.5)
 fig.suptitle("Moreau (2005) Fig. 3: indetermination clouds of two contact forces, with the exact projection "
              "of A ∩ C (shaded) inside the Coulomb sector (grey)", fontsize=11)
-fig.savefig(out.png, dpi=150)
-fig.savefig(out.pdf)
+save(fig, out, dpi=150)
 plt.show()
 
 # %% [markdown]
@@ -311,8 +301,8 @@ plt.show()
 #   exact polygons show how much it misses.
 # * **Random initial guesses** (section 2's other exploration; normal impulses
 #   uniform in $[0, \max s_n^{\text{rest}}]$, tangential ones uniform in the
-#   sector, fixed review order) cover most of each polygon (about 60 % and
-#   95 %), at the same cost per run.
+#   sector, fixed review order) cover most of each polygon (the coverage
+#   table above gives the measured fractions), at the same cost per run.
 # * **Warm start** (the impulses of the last deposition step): every run stops
 #   after one sweep at one point (spread $\sim 10^{-12}$ N), the "very little
 #   indeterminacy" of section 2. That point is interior to $A \cap C$.

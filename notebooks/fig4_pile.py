@@ -80,20 +80,11 @@ from matplotlib.patches import Circle
 
 from ncd.figures import cuts as cm
 
-try:
-    snakemake  # noqa: F821 (injected by Snakemake's notebook directive)
-    inp, out, cfg = snakemake.input, snakemake.output, snakemake.params.config  # noqa: F821
-except NameError:  # interactive use, from the repository root after `snakemake -j2 fig4_pile`
-    import yaml
+from ncd.notebook import paths, save
 
-    class _P(dict):
-        __getattr__ = dict.__getitem__
-
-    d = "results/fig4_pile"
-    inp = _P(construction=f"{d}/construction.nc", cuts=f"{d}/cuts.nc", ensemble=f"{d}/ensemble.nc",
-             tolerance=f"{d}/tolerance.nc")
-    out = _P(png="results/figures/fig4_pile.png", pdf="results/figures/fig4_pile.pdf")
-    cfg = yaml.safe_load(open("config.yaml"))["fig4_pile"]
+# Snakemake's object, or by hand (from the repository or notebooks/) the files under results/
+_smk = paths("fig4_pile", ["construction", "cuts", "ensemble", "tolerance"], globals().get("snakemake"))
+inp, out, cfg = _smk.input, _smk.output, _smk.params.config
 
 con = xr.load_dataset(inp.construction)
 cuts = xr.load_dataset(inp.cuts)
@@ -359,8 +350,7 @@ ax.set_title(f"(g) construction: {con.sizes['step']} steps, {1e3 * float(con.wal
 
 fig.suptitle("Moreau (2005), Fig. 4: resultant force transmitted across a vertical cut in a poured pile",
              fontsize=12, y=0.985)
-fig.savefig(out.png, dpi=130, bbox_inches="tight")
-fig.savefig(out.pdf, bbox_inches="tight")
+save(fig, out, dpi=130, bbox_inches="tight")
 
 # %% [markdown]
 # ## What we measured, and where the reproduction differs
@@ -372,10 +362,9 @@ fig.savefig(out.pdf, bbox_inches="tight")
 #
 # * **Size and cost.** The paper does not give its number of grains; we pour
 #   1000 in about 5200 steps of 0.3 ms and reach rest after about 7900 steps
-#   (2.4 s, 166 $\sqrt{d/g}$). On this 2-core machine the construction takes
-#   about 1.5 min (≈ 11 ms per step on average, ≈ 27 ms at the end of the
-#   pouring, mostly NLGS sweeps), a zero-guess run to $10^{-5}$ about 0.3 s of
-#   CPU (3300 sweeps, median), so the 500 runs take about 2.5 CPU minutes.
+#   (2.4 s, 166 $\sqrt{d/g}$). The construction's wall time per step and a
+#   zero-guess run's sweeps and CPU time are printed above from this run's data
+#   (mostly NLGS sweeps); `results/index.html` gives each figure's run time.
 #   The source is raised with the pile (a funnel kept 1.5 d above the grains
 #   under it) rather than fixed: gentle impacts allow $h = 0.3$ ms with
 #   interpenetrations below 0.05 d.

@@ -63,12 +63,10 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 from IPython.display import display, Markdown
 
-try:
-    snakemake  # noqa: B018 (injected by Snakemake's notebook directive)
-except NameError:  # run by hand on the results of a finished run
-    from types import SimpleNamespace
-    snakemake = SimpleNamespace(input=SimpleNamespace(table="../results/stability/table.nc"),
-                                output=SimpleNamespace(png="stability.png", pdf="stability.pdf"))
+from ncd.notebook import paths, save
+
+# Snakemake's object, or by hand (from the repository or notebooks/) the files under results/
+snakemake = paths("stability", ["table"], globals().get("snakemake"))
 
 ds = xr.load_dataset(snakemake.input.table)
 cols = ["case", "method", "restitution", "h", "h_over_hcrit", "n_steps", "stable", "diverged", "diverged_step", "nan",
@@ -176,8 +174,7 @@ ax.set_ylabel(r"$(E - E_0)/E_s$")
 ax.set_title("(d) Newton's cradle, e = 1: energy kept?")
 ax.legend(fontsize=7, ncol=2)
 fig.tight_layout()
-fig.savefig(snakemake.output.png, dpi=110)
-fig.savefig(snakemake.output.pdf)
+save(fig, snakemake.output, dpi=110, show=True)
 
 # %% [markdown]
 # ## Verdicts
