@@ -28,6 +28,9 @@ for _figure in FIGURES:
 # the reproduction page results/index.html (claims, verdicts, provenance, run times)
 include: "workflow/rules/index.smk"
 
+# ParaView (VTK) and animations of stored frames: `snakemake -j2 export` (not in the default target)
+include: "workflow/rules/export.smk"
+
 # the benchmark suite: `snakemake -j2 bench` (not part of the default target)
 if "bench" in config:
     include: "workflow/rules/bench.smk"

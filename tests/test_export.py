@@ -1,0 +1,74 @@
+"""ncd.export: stored frames to VTK (ParaView) and to an animation, values preserved."""
+import xml.etree.ElementTree as ET
+
+import meshio
+import numpy as np
+import pytest
+import xarray as xr
+
+from ncd.export import ExportError, animate, write_vtk
+from ncd.figures.slope import frames_dataset
+
+
+def _frames(n_frames=3, n_discs=4):
+    rng = np.random.default_rng(1)
+    frames = []
+    for i in range(n_frames):
+        pos = rng.random((n_discs, 2))
+        n_c = 2 + i  # the contact count changes from frame to frame
+        frames.append({"pos": pos, "vel": rng.random((n_discs, 2)), "spin": rng.random(n_discs),
+                       "angle": rng.random(n_discs), "time": 0.1 * (i + 1),
+                       "body_a": np.arange(n_c) % n_discs, "body_b": -np.ones(n_c, int),
+                       "force_n": np.arange(1.0, n_c + 1), "force_t": -np.arange(n_c) * 0.1,
+                       "a": pos[np.arange(n_c) % n_discs], "b": pos[np.arange(n_c) % n_discs] + 0.05})
+    ds = frames_dataset(frames, [2, 4, 6])
+    return ds.assign(radius=("disc", np.full(n_discs, 0.05))), frames
+
+
+def test_frames_are_padded_and_described():
+    ds, frames = _frames()
+    assert ds.sizes["frame"] == 3 and ds.sizes["frame_contact"] == 4
+    np.testing.assert_array_equal(ds.frame_body_a.values[0], [0, 1, -1, -1])
+    assert np.isnan(ds.frame_force_n.values[0, 2:]).all()
+    for name, var in ds.data_vars.items():
+        if name.startswith("frame_"):
+            assert var.attrs["units"] and var.attrs["long_name"], name
+
+
+def test_vtk_series_round_trip(tmp_path):
+    ds, frames = _frames()
+    discs, contacts = write_vtk(ds, tmp_path, "flow")
+    for pvd in (discs, contacts):
+        files = [e.attrib for e in ET.parse(pvd).getroot().iter("DataSet")]
+        assert [float(f["timestep"]) for f in files] == pytest.approx([0.1, 0.2, 0.3])
+        assert all((tmp_path / f["file"]).exists() for f in files)
+    m = meshio.read(tmp_path / "flow_discs_0001.vtu")
+    np.testing.assert_allclose(m.points[:, :2], frames[1]["pos"])
+    np.testing.assert_allclose(m.point_data["velocity"][:, :2], frames[1]["vel"])
+    np.testing.assert_allclose(m.point_data["spin"], frames[1]["spin"])
+    c = meshio.read(tmp_path / "flow_contacts_0002.vtu")
+    assert len(c.cells[0].data) == 4
+    np.testing.assert_allclose(c.cell_data["force_n"][0], [1, 2, 3, 4])
+    np.testing.assert_allclose(c.points[c.cells[0].data[3], :2], [frames[2]["a"][3], frames[2]["b"][3]])
+
+
+def test_animation_has_every_frame(tmp_path):
+    ds, _ = _frames()
+    path = animate(ds, tmp_path / "movie.mp4", fps=5)
+    assert path.exists() and path.stat().st_size > 1000
+    if path.suffix == ".gif":
+        from PIL import Image
+
+        with Image.open(path) as im:
+            assert im.n_frames == 3
+    else:
+        import subprocess
+
+        out = subprocess.run(["ffprobe", "-v", "error", "-count_frames", "-select_streams", "v:0", "-show_entries",
+                              "stream=nb_read_frames", "-of", "csv=p=0", str(path)], capture_output=True, text=True)
+        assert out.stdout.strip() == "3"
+
+
+def test_no_frames_is_a_clear_error(tmp_path):
+    with pytest.raises(ExportError, match="snapshot_every"):
+        write_vtk(xr.Dataset({"pos_x": ("disc", np.zeros(2))}), tmp_path)
