@@ -33,7 +33,7 @@ from .metadata import KNOWN, default_attrs
 
 REFERENCES = ("J. J. Moreau, Indetermination in the numerical simulation of granular systems, "
               "in Powders and Grains 2005, R. Garcia-Rojo, H. J. Herrmann, S. McNamara (eds.), "
-              "Balkema, Leiden, 2005, pp. 109-112 (hal-01824602)")
+              "Balkema, Leiden, 2005 (hal-01824602)")
 CONVENTIONS = "CF-1.10"
 COMPRESSION = {"zlib": True, "complevel": 4, "shuffle": True}
 STRICT_ENV = "NCD_STRICT_METADATA"  # "1": a variable without units/long_name is an error
