@@ -25,6 +25,8 @@ rule bench_core:
         log(FIGB, "core"),
     benchmark:
         bench(FIGB, "core")
+    conda:
+        CONDA_ENV
     script:
         "../scripts/bench_core.py"
 
@@ -41,6 +43,8 @@ rule bench_sweeps:
         log(FIGB, "sweeps"),
     benchmark:
         bench(FIGB, "sweeps")
+    conda:
+        CONDA_ENV
     script:
         "../scripts/bench_sweeps.py"
 
@@ -57,6 +61,8 @@ rule bench_ensemble:
         log(FIGB, "ensemble"),
     benchmark:
         bench(FIGB, "ensemble")
+    conda:
+        CONDA_ENV
     script:
         "../scripts/bench_ensemble.py"
 
@@ -73,6 +79,8 @@ rule bench_peer:
         log(FIGB, "peer"),
     benchmark:
         bench(FIGB, "peer")
+    conda:
+        CONDA_ENV
     script:
         "../scripts/bench_peer.py"
 
@@ -90,6 +98,8 @@ rule bench_rules:
         log(FIGB, "rules"),
     benchmark:
         bench(FIGB, "rules")
+    conda:
+        CONDA_ENV
     script:
         "../scripts/bench_rules.py"
 
@@ -101,14 +111,17 @@ rule bench_notebook:
         ensemble="results/bench/ensemble.nc",
         peer="results/bench/peer.nc",
         rules="results/bench/rules.nc",
-        notebook=str(ROOT / "notebooks" / "bench.ipynb"),
+        notebook=notebook_file("bench"),
+        notebook_py=notebook_file("bench", "py"),
     output:
-        png="results/figures/bench.png",
-        pdf="results/figures/bench.pdf",
+        png=figure_output("bench", "png"),
+        pdf=figure_output("bench", "pdf"),
     log:
         notebook="results/notebooks/bench.ipynb",
     benchmark:
         bench(FIGB, "notebook")
+    conda:
+        CONDA_ENV
     notebook:
         "../../notebooks/bench.ipynb"
 

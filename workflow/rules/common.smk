@@ -9,11 +9,17 @@
 #                   generic rule `render_html` turns it into results/html/<fig>.html
 #   logs, benches   results/logs/<fig>/<rule>*.log, results/benchmarks/<fig>/<rule>*.tsv
 import glob
+import os
 from pathlib import Path
 
 from ncd.configcheck import check_config
 
 ROOT = Path(workflow.basedir)
+# Every rule input and output is relative to the working directory, so that a moved or
+# cloned checkout with its results/ and .snakemake/ plans nothing (tests/test_relocation.py).
+REL = Path(os.path.relpath(ROOT))
+# The conda environment of every rule (`--software-deployment-method conda`).
+CONDA_ENV = "../envs/ncd.yaml"
 
 # Figures in the order of the paper; each has a rules file and a config section.
 FIGURES = [f for f in ("fig1_wedged", "fig2_slope", "fig3_equilibrium", "fig4_pile", "fig4_history",
@@ -32,7 +38,7 @@ ENSEMBLE_THREADS = 2
 # The sources a figure's simulation and exploration rules depend on: the solver core
 # (every module at the top of ncd/) and the figure's own modules, so that editing the
 # core reruns every figure and editing a figure's module reruns that figure only.
-NCD_CORE = sorted(str(p) for p in (ROOT / "ncd").glob("*.py"))
+NCD_CORE = sorted(str(REL / "ncd" / p.name) for p in (ROOT / "ncd").glob("*.py"))
 NCD_MODULES = {
     "fig1_wedged": ["figures/__init__.py", "figures/wedged.py"],
     "fig2_slope": ["figures/__init__.py", "figures/slope.py", "figures/slope_analysis.py"],
@@ -51,7 +57,7 @@ NCD_MODULES = {
 
 def ncd_sources(figure):
     """Input files of a figure's computing rules: the solver core and the figure's modules."""
-    return NCD_CORE + [str(ROOT / "ncd" / m) for m in NCD_MODULES[figure]]
+    return NCD_CORE + [str(REL / "ncd" / m) for m in NCD_MODULES[figure]]
 
 
 def section(figure):
@@ -75,6 +81,22 @@ def shard_files(figure, name, n_shards):
     return [f"results/{figure}/shards/{name}_{k}-of-{n_shards}.nc" for k in range(n_shards)]
 
 
+def notebook_file(figure, ext="ipynb"):
+    """The notebook of a figure: ``.ipynb`` (run by Snakemake) or ``.py`` (its jupytext pair;
+    an input too, so that editing it reruns the notebook, and ncd.notebook.paths stops the
+    run when the pair differs: `jupytext --sync` was forgotten)."""
+    return str(REL / "notebooks" / f"{figure}.{ext}")
+
+
+def figure_output(figure, ext):
+    """``results/figures/<figure>.<ext>``, marked for ``snakemake --report report.zip`` with the
+    caption ``workflow/report/<figure>.rst`` (or the generic ``figure.rst``)."""
+    name = figure if (ROOT / "workflow" / "report" / f"{figure}.rst").exists() else "figure"
+    # a caption path is relative to the rules file (workflow/rules/)
+    return report(f"results/figures/{figure}.{ext}", caption=f"../report/{name}.rst",
+                  category=figure, subcategory=ext.upper())
+
+
 def figure_targets(figure):
     return [f"results/html/{figure}.html", f"results/figures/{figure}.png",
             f"results/figures/{figure}.pdf"]
@@ -88,10 +110,27 @@ def bench(figure, rule_name):
     return f"results/benchmarks/{figure}/{rule_name}.tsv"
 
 
+rule html_mathjax:
+    """MathJax, copied beside the pages from the jupyter-server-mathjax package (maths offline)."""
+    output:
+        directory("results/html/mathjax"),
+    log:
+        "results/logs/html/mathjax.log",
+    benchmark:
+        "results/benchmarks/html/mathjax.tsv"
+    conda:
+        CONDA_ENV
+    script:
+        "../scripts/html_mathjax.py"
+
+
 rule render_html:
-    """Render an executed notebook (written by its figure's notebook rule) to HTML."""
+    """Render an executed notebook (written by its figure's notebook rule) to a clean HTML
+    page: no Snakemake preamble, code hidden behind a button, long tables folded, maths
+    typeset offline (ncd.render)."""
     input:
         png="results/figures/{figure}.png",
+        mathjax="results/html/mathjax",
     output:
         html="results/html/{figure}.html",
     params:
@@ -100,9 +139,10 @@ rule render_html:
         "results/logs/{figure}/render_html.log",
     benchmark:
         "results/benchmarks/{figure}/render_html.tsv"
-    shell:
-        "jupyter nbconvert --to html --output-dir results/html --output {wildcards.figure} "
-        "{params.executed} > {log} 2>&1"
+    conda:
+        CONDA_ENV
+    script:
+        "../scripts/render_html.py"
 
 
 rule thumbnail:
@@ -115,6 +155,8 @@ rule thumbnail:
         "results/logs/thumbnails/{figure}.log",
     benchmark:
         "results/benchmarks/thumbnails/{figure}.tsv"
+    conda:
+        CONDA_ENV
     script:
         "../scripts/thumbnail.py"
 

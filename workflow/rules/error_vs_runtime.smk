@@ -16,6 +16,8 @@ rule error_vs_runtime_nlgs:
         log(FIG, "error_vs_runtime_nlgs"),
     benchmark:
         bench(FIG, "error_vs_runtime_nlgs")
+    conda:
+        CONDA_ENV
     script:
         "../scripts/error_vs_runtime_nlgs.py"
 
@@ -32,6 +34,8 @@ rule error_vs_runtime_integration:
         log(FIG, "error_vs_runtime_integration"),
     benchmark:
         bench(FIG, "error_vs_runtime_integration")
+    conda:
+        CONDA_ENV
     script:
         "../scripts/error_vs_runtime_integration.py"
 
@@ -40,14 +44,17 @@ rule error_vs_runtime_notebook:
     input:
         nlgs="results/error_vs_runtime/nlgs.nc",
         integration="results/error_vs_runtime/integration.nc",
-        notebook=str(ROOT / "notebooks" / "error_vs_runtime.ipynb"),
+        notebook=notebook_file("error_vs_runtime"),
+        notebook_py=notebook_file("error_vs_runtime", "py"),
     output:
-        png="results/figures/error_vs_runtime.png",
-        pdf="results/figures/error_vs_runtime.pdf",
+        png=figure_output("error_vs_runtime", "png"),
+        pdf=figure_output("error_vs_runtime", "pdf"),
     log:
         notebook="results/notebooks/error_vs_runtime.ipynb",
     benchmark:
         bench(FIG, "error_vs_runtime_notebook")
+    conda:
+        CONDA_ENV
     notebook:
         "../../notebooks/error_vs_runtime.ipynb"
 

@@ -8,7 +8,7 @@ rule fig1_wedged_explore:
     input:
         ncd_sources(FIG),
     output:
-        "results/fig1_wedged/shards/{name}_{shard}-of-{n}.nc",
+        temp("results/fig1_wedged/shards/{name}_{shard}-of-{n}.nc"),
     wildcard_constraints:
         name="ensemble",
         shard=r"\d+",
@@ -20,6 +20,8 @@ rule fig1_wedged_explore:
         log(FIG, "explore_{name}_{shard}-of-{n}"),
     benchmark:
         bench(FIG, "explore_{name}_{shard}-of-{n}")
+    conda:
+        CONDA_ENV
     script:
         "../scripts/fig1_explore.py"
 
@@ -35,6 +37,8 @@ rule fig1_wedged_merge:
         log(FIG, "merge"),
     benchmark:
         bench(FIG, "merge")
+    conda:
+        CONDA_ENV
     script:
         "../scripts/merge_shards.py"
 
@@ -52,6 +56,8 @@ rule fig1_wedged_simulate:
         log(FIG, "simulate"),
     benchmark:
         bench(FIG, "simulate")
+    conda:
+        CONDA_ENV
     script:
         "../scripts/fig1_simulate.py"
 
@@ -69,6 +75,8 @@ rule fig1_wedged_sweep:
         log(FIG, "sweep"),
     benchmark:
         bench(FIG, "sweep")
+    conda:
+        CONDA_ENV
     script:
         "../scripts/fig1_sweep.py"
 
@@ -78,14 +86,17 @@ rule fig1_wedged_notebook:
         ensemble="results/fig1_wedged/ensemble.nc",
         evolutions="results/fig1_wedged/evolutions.nc",
         sweep="results/fig1_wedged/sweep.nc",
-        notebook=str(ROOT / "notebooks" / "fig1_wedged.ipynb"),
+        notebook=notebook_file("fig1_wedged"),
+        notebook_py=notebook_file("fig1_wedged", "py"),
     output:
-        png="results/figures/fig1_wedged.png",
-        pdf="results/figures/fig1_wedged.pdf",
+        png=figure_output("fig1_wedged", "png"),
+        pdf=figure_output("fig1_wedged", "pdf"),
     log:
         notebook="results/notebooks/fig1_wedged.ipynb",
     benchmark:
         bench(FIG, "notebook")
+    conda:
+        CONDA_ENV
     notebook:
         "../../notebooks/fig1_wedged.ipynb"
 

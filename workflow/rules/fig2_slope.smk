@@ -26,6 +26,8 @@ rule fig2_slope_simulate:
         log(FIG2, "simulate"),
     benchmark:
         bench(FIG2, "simulate")
+    conda:
+        CONDA_ENV
     script:
         "../scripts/fig2_slope_simulate.py"
 
@@ -35,7 +37,7 @@ rule fig2_slope_explore:
         ncd_sources(FIG2),
         trajectory=f"{F2}/trajectory.nc",
     output:
-        f"{F2}/shards/ensemble_{{shard}}-of-{{n}}.nc",
+        temp(f"{F2}/shards/ensemble_{{shard}}-of-{{n}}.nc"),
     wildcard_constraints:
         shard=r"\d+",
         n=r"\d+",
@@ -46,6 +48,8 @@ rule fig2_slope_explore:
         log(FIG2, "explore_{shard}-of-{n}"),
     benchmark:
         bench(FIG2, "explore_{shard}-of-{n}")
+    conda:
+        CONDA_ENV
     script:
         "../scripts/fig2_slope_explore.py"
 
@@ -61,6 +65,8 @@ rule fig2_slope_merge:
         log(FIG2, "merge"),
     benchmark:
         bench(FIG2, "merge")
+    conda:
+        CONDA_ENV
     script:
         "../scripts/merge_shards.py"
 
@@ -78,6 +84,8 @@ rule fig2_slope_analyse:
         log(FIG2, "analyse"),
     benchmark:
         bench(FIG2, "analyse")
+    conda:
+        CONDA_ENV
     script:
         "../scripts/fig2_slope_analyse.py"
 
@@ -87,16 +95,19 @@ rule fig2_slope_notebook:
         trajectory=f"{F2}/trajectory.nc",
         ensemble=f"{F2}/ensemble.nc",
         measures=f"{F2}/measures.nc",
-        notebook=str(ROOT / "notebooks" / f"{FIG2}.ipynb"),
+        notebook=notebook_file(FIG2),
+        notebook_py=notebook_file(FIG2, "py"),
     output:
-        png=f"results/figures/{FIG2}.png",
-        pdf=f"results/figures/{FIG2}.pdf",
+        png=figure_output(FIG2, "png"),
+        pdf=figure_output(FIG2, "pdf"),
     params:
         config=without_shards(CFG2),
     log:
         notebook=f"results/notebooks/{FIG2}.ipynb",
     benchmark:
         bench(FIG2, "notebook")
+    conda:
+        CONDA_ENV
     notebook:
         "../../notebooks/fig2_slope.ipynb"
 

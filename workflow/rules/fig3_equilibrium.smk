@@ -23,6 +23,8 @@ rule fig3_equilibrium_simulate:
         log(FIG, "simulate"),
     benchmark:
         bench(FIG, "simulate")
+    conda:
+        CONDA_ENV
     script:
         "../scripts/fig3_equilibrium_simulate.py"
 
@@ -32,7 +34,7 @@ rule fig3_equilibrium_explore:
         ncd_sources(FIG),
         state=f"{F3}/state.nc",
     output:
-        f"{F3}/shards/{{name}}_{{shard}}-of-{{n}}.nc",
+        temp(f"{F3}/shards/{{name}}_{{shard}}-of-{{n}}.nc"),
     wildcard_constraints:
         name="|".join(F3_MODES),
         shard=r"\d+",
@@ -44,6 +46,8 @@ rule fig3_equilibrium_explore:
         log(FIG, "explore_{name}_{shard}-of-{n}"),
     benchmark:
         bench(FIG, "explore_{name}_{shard}-of-{n}")
+    conda:
+        CONDA_ENV
     script:
         "../scripts/fig3_equilibrium_explore.py"
 
@@ -59,6 +63,8 @@ rule fig3_equilibrium_merge:
         log(FIG, "merge"),
     benchmark:
         bench(FIG, "merge")
+    conda:
+        CONDA_ENV
     script:
         "../scripts/merge_shards.py"
 
@@ -75,6 +81,8 @@ rule fig3_equilibrium_projection:
         log(FIG, "projection"),
     benchmark:
         bench(FIG, "projection")
+    conda:
+        CONDA_ENV
     script:
         "../scripts/fig3_equilibrium_projection.py"
 
@@ -91,6 +99,8 @@ rule fig3_equilibrium_uniform:
         log(FIG, "uniform"),
     benchmark:
         bench(FIG, "uniform")
+    conda:
+        CONDA_ENV
     script:
         "../scripts/fig3_equilibrium_uniform.py"
 
@@ -101,16 +111,19 @@ rule fig3_equilibrium_notebook:
         ensemble=f"{F3}/ensemble.nc",
         projection=f"{F3}/projection.nc",
         uniform=f"{F3}/uniform.nc",
-        notebook=str(ROOT / "notebooks" / f"{FIG}.ipynb"),
+        notebook=notebook_file(FIG),
+        notebook_py=notebook_file(FIG, "py"),
     output:
-        png=f"results/figures/{FIG}.png",
-        pdf=f"results/figures/{FIG}.pdf",
+        png=figure_output(FIG, "png"),
+        pdf=figure_output(FIG, "pdf"),
     params:
         config=without_shards(CFG),
     log:
         notebook=f"results/notebooks/{FIG}.ipynb",
     benchmark:
         bench(FIG, "notebook")
+    conda:
+        CONDA_ENV
     notebook:
         "../../notebooks/fig3_equilibrium.ipynb"
 

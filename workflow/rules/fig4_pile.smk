@@ -28,6 +28,8 @@ rule fig4_pile_simulate:
         log(FIG4, "simulate"),
     benchmark:
         bench(FIG4, "simulate")
+    conda:
+        CONDA_ENV
     script:
         "../scripts/fig4_pile_simulate.py"
 
@@ -44,6 +46,8 @@ rule fig4_pile_cuts:
         log(FIG4, "cuts"),
     benchmark:
         bench(FIG4, "cuts")
+    conda:
+        CONDA_ENV
     script:
         "../scripts/fig4_pile_cuts.py"
 
@@ -54,7 +58,7 @@ rule fig4_pile_explore:
         construction=f"{F4}/construction.nc",
         cuts=f"{F4}/cuts.nc",
     output:
-        f"{F4}/shards/{{name}}_{{shard}}-of-{{n}}.nc",
+        temp(f"{F4}/shards/{{name}}_{{shard}}-of-{{n}}.nc"),
     wildcard_constraints:
         name="ensemble|tolerance",
         shard=r"\d+",
@@ -66,6 +70,8 @@ rule fig4_pile_explore:
         log(FIG4, "explore_{name}_{shard}-of-{n}"),
     benchmark:
         bench(FIG4, "explore_{name}_{shard}-of-{n}")
+    conda:
+        CONDA_ENV
     script:
         "../scripts/fig4_pile_explore.py"
 
@@ -83,6 +89,8 @@ rule fig4_pile_merge:
         log(FIG4, "merge_{name}"),
     benchmark:
         bench(FIG4, "merge_{name}")
+    conda:
+        CONDA_ENV
     script:
         "../scripts/merge_shards.py"
 
@@ -93,16 +101,19 @@ rule fig4_pile_notebook:
         cuts=f"{F4}/cuts.nc",
         ensemble=f"{F4}/ensemble.nc",
         tolerance=f"{F4}/tolerance.nc",
-        notebook=str(ROOT / "notebooks" / f"{FIG4}.ipynb"),
+        notebook=notebook_file(FIG4),
+        notebook_py=notebook_file(FIG4, "py"),
     output:
-        png=f"results/figures/{FIG4}.png",
-        pdf=f"results/figures/{FIG4}.pdf",
+        png=figure_output(FIG4, "png"),
+        pdf=figure_output(FIG4, "pdf"),
     params:
         config=without_shards(CFG4),
     log:
         notebook=f"results/notebooks/{FIG4}.ipynb",
     benchmark:
         bench(FIG4, "notebook")
+    conda:
+        CONDA_ENV
     notebook:
         "../../notebooks/fig4_pile.ipynb"
 

@@ -16,6 +16,8 @@ rule stability_simulate:
         log(FIG, "stability_simulate"),
     benchmark:
         bench(FIG, "stability_simulate")
+    conda:
+        CONDA_ENV
     script:
         "../scripts/stability_simulate.py"
 
@@ -23,14 +25,17 @@ rule stability_simulate:
 rule stability_notebook:
     input:
         table="results/stability/table.nc",
-        notebook=str(ROOT / "notebooks" / "stability.ipynb"),
+        notebook=notebook_file("stability"),
+        notebook_py=notebook_file("stability", "py"),
     output:
-        png="results/figures/stability.png",
-        pdf="results/figures/stability.pdf",
+        png=figure_output("stability", "png"),
+        pdf=figure_output("stability", "pdf"),
     log:
         notebook="results/notebooks/stability.ipynb",
     benchmark:
         bench(FIG, "stability_notebook")
+    conda:
+        CONDA_ENV
     notebook:
         "../../notebooks/stability.ipynb"
 
