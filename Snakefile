@@ -13,6 +13,7 @@ configfile: str(Path(workflow.basedir) / "config.yaml")
 validate(config, str(Path(workflow.basedir) / "workflow/schemas/config.schema.yaml"))
 
 include: "workflow/rules/common.smk"
+include: "workflow/rules/html.smk"
 
 # A run killed with SIGKILL leaves its locks: remove them (and stray *.part files) when no
 # Snakemake process or job still runs here, so that a plain rerun needs no --unlock; its

@@ -23,7 +23,7 @@ CONDA_ENV = "../envs/ncd.yaml"
 
 # Figures in the order of the paper; each has a rules file and a config section.
 FIGURES = [f for f in ("fig1_wedged", "fig2_slope", "fig3_equilibrium", "fig4_pile", "fig4_history",
-                       "stability", "error_vs_runtime")
+                       "fig5_governing", "stability", "error_vs_runtime")
            if (ROOT / "workflow" / "rules" / f"{f}.smk").exists()]
 
 # Every config section (a missing figure section included) is checked here, before any
@@ -47,6 +47,8 @@ NCD_MODULES = {
                   "figures/sources.py"],
     "fig4_history": ["figures/__init__.py", "figures/pile.py", "figures/cuts.py", "figures/construction.py",
                      "figures/sources.py", "figures/history.py", "figures/history_analysis.py"],
+    "fig5_governing": ["figures/__init__.py", "figures/equilibrium.py", "figures/governing.py",
+                       "figures/governing_exact.py", "figures/governing_plot.py"],
     "stability": ["studies/__init__.py", "studies/stability.py", "studies/scenes.py"],
     "error_vs_runtime": ["studies/__init__.py", "studies/work_precision.py", "studies/scenes.py"],
     "bench": ["studies/__init__.py", "studies/bench.py", "studies/peer.py", "studies/c_sweep.c",
@@ -108,60 +110,3 @@ def log(figure, rule_name):
 
 def bench(figure, rule_name):
     return f"results/benchmarks/{figure}/{rule_name}.tsv"
-
-
-rule html_mathjax:
-    """MathJax, copied beside the pages from the jupyter-server-mathjax package (maths offline)."""
-    output:
-        directory("results/html/mathjax"),
-    log:
-        "results/logs/html/mathjax.log",
-    benchmark:
-        "results/benchmarks/html/mathjax.tsv"
-    conda:
-        CONDA_ENV
-    script:
-        "../scripts/html_mathjax.py"
-
-
-rule render_html:
-    """Render an executed notebook (written by its figure's notebook rule) to a clean HTML
-    page: no Snakemake preamble, code hidden behind a button, long tables folded, maths
-    typeset offline (ncd.render)."""
-    input:
-        png="results/figures/{figure}.png",
-        mathjax="results/html/mathjax",
-    output:
-        html="results/html/{figure}.html",
-    params:
-        executed="results/notebooks/{figure}.ipynb",
-    log:
-        "results/logs/{figure}/render_html.log",
-    benchmark:
-        "results/benchmarks/{figure}/render_html.tsv"
-    conda:
-        CONDA_ENV
-    script:
-        "../scripts/render_html.py"
-
-
-rule thumbnail:
-    """A small copy of a figure for the README (docs/thumbnails, committed)."""
-    input:
-        "results/figures/{figure}.png",
-    output:
-        "docs/thumbnails/{figure}.png",
-    log:
-        "results/logs/thumbnails/{figure}.log",
-    benchmark:
-        "results/benchmarks/thumbnails/{figure}.tsv"
-    conda:
-        CONDA_ENV
-    script:
-        "../scripts/thumbnail.py"
-
-
-rule thumbnails:
-    """`snakemake -j2 thumbnails`: refresh the README's thumbnails (not in the default target)."""
-    input:
-        [f"docs/thumbnails/{f}.png" for f in FIGURES],
