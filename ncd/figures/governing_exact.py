@@ -1,0 +1,202 @@
+"""Exact measures of ``A ∩ C`` for the packings of figure 5 (Moreau 2005, section 4).
+
+Per packing (``H r + F = 0`` from :func:`ncd.contacts.h_matrix`, Coulomb sectors,
+scaled as in :class:`ncd.polytope.ForcePolytope`):
+
+* ``rank H``, ``dim A = 2 kappa - rank H``;
+* the exact range ``[min, max]`` of every contact's normal and tangential force
+  over ``A ∩ C``: 4 kappa linear programs solved by HiGHS (``highspy``), one
+  model whose objective alone changes, each solve warm-started from the last
+  basis (:func:`force_ranges`);
+* the implicit equalities of ``A ∩ C`` (Coulomb rows tight at every point: a
+  contact carrying no force, or forced to slide), found from the LP points and
+  confirmed one by one by LP; the *rank count*
+  ``dim (A ∩ C) = 2 kappa - rank [H; implicit rows]``;
+* the *LP dimension*: the affine rank of LP points of ``A ∩ C``, completed by
+  LPs along directions of the affine hull not yet spanned, until every such
+  direction is either spanned or found flat (:func:`lp_dimension`); it equals
+  the rank count when both are right, which the tests check on every packing;
+* contacts fixed by statics (both ranges of width ``<= width_tol * scale``);
+* the exact indeterminacy ratio (defined here)
+  ``eta_exact = sum_alpha |(Δr_n, Δr_t)|_alpha / sum_alpha |r̄_alpha|``,
+  ``Δ`` the widths of the ranges and ``r̄`` the centre of the range box, i.e. the
+  mean over contacts of the diagonal of the bounding box of the contact's
+  projection over the mean force at the box centres.
+"""
+import numpy as np
+
+from ..polytope import ForcePolytope, PolytopeError
+
+try:
+    import highspy
+except ImportError:         # pragma: no cover - a dependency in pyproject.toml
+    highspy = None
+
+
+class _Model:
+    """One HiGHS model of the scaled ``A ∩ C``: rows ``A_eq x = b_eq`` and ``G x <= 0``."""
+
+    def __init__(self, P, feas_tol=1e-10):
+        import scipy.sparse as sp
+        if highspy is None:
+            raise ImportError("highspy is required for the exact measures of figure 5")
+        self.P = P
+        n = 2 * P.n_contacts
+        A = sp.vstack([P.A_eq, P.G]).tocsc()
+        m_eq = P.A_eq.shape[0]
+        inf = highspy.kHighsInf
+        lp = highspy.HighsLp()
+        lp.num_col_, lp.num_row_ = n, A.shape[0]
+        lp.col_cost_ = np.zeros(n)
+        lp.col_lower_ = np.full(n, -inf)
+        lp.col_upper_ = np.full(n, inf)
+        lp.row_lower_ = np.concatenate([P.b_eq, np.full(P.G.shape[0], -inf)])
+        lp.row_upper_ = np.concatenate([P.b_eq, np.zeros(P.G.shape[0])])
+        lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
+        lp.a_matrix_.start_ = A.indptr
+        lp.a_matrix_.index_ = A.indices
+        lp.a_matrix_.value_ = A.data
+        self.h = highspy.Highs()
+        self.h.setOptionValue("output_flag", False)
+        self.h.setOptionValue("primal_feasibility_tolerance", feas_tol)
+        self.h.setOptionValue("dual_feasibility_tolerance", feas_tol)
+        self.h.setOptionValue("threads", 1)
+        self.h.setOptionValue("presolve", "off")      # keep the basis: each solve is warm-started
+        self.h.setOptionValue("solver", "simplex")
+        self.h.passModel(lp)
+        self.n, self.m_eq = n, m_eq
+        self.cost = np.zeros(n)
+        self.n_lp = 0
+
+    def minimize(self, c):
+        """``argmin c . x`` (scaled), or None if infeasible; raises on any other failure."""
+        c = np.asarray(c, float)
+        changed = np.nonzero(c != self.cost)[0]
+        if len(changed):
+            self.h.changeColsCost(len(changed), changed.astype(np.int32), c[changed])
+            self.cost = c.copy()
+        self.h.run()
+        self.n_lp += 1
+        status = self.h.getModelStatus()
+        if status == highspy.HighsModelStatus.kInfeasible:
+            return None
+        if status != highspy.HighsModelStatus.kOptimal:
+            raise PolytopeError(f"LP failed: {self.h.modelStatusToString(status)}")
+        return np.array(self.h.getSolution().col_value)
+
+
+def force_ranges(P, model):
+    """Exact ``[min, max]`` of ``r_n`` and ``r_t`` of every contact (scaled units) and the
+    LP points found (rows of ``points``)."""
+    k = P.n_contacts
+    lo, hi = np.zeros((k, 2)), np.zeros((k, 2))
+    points = []
+    c = np.zeros(2 * k)
+    for a in range(k):
+        for comp in range(2):
+            j = 2 * a + comp
+            for sign in (1.0, -1.0):
+                c[:] = 0.0
+                c[j] = sign
+                x = model.minimize(c)
+                if x is None:
+                    raise PolytopeError("A ∩ C is empty")
+                points.append(x)
+                if sign > 0:
+                    lo[a, comp] = x[j]
+                else:
+                    hi[a, comp] = x[j]
+    return lo, hi, np.array(points)
+
+
+def implicit_rows(P, model, points, tol):
+    """Coulomb rows tight at every point of ``A ∩ C``: candidates are the rows tight at
+    every LP point found; each is confirmed by maximizing its slack."""
+    G = P.G.toarray()
+    slack = -(points @ G.T)                    # (points, rows) >= 0
+    candidate = np.nonzero(slack.max(axis=0) <= tol)[0]
+    implicit = np.zeros(G.shape[0], bool)
+    extra = []
+    for i in candidate:
+        x = model.minimize(G[i])               # maximize the slack -G_i x
+        extra.append(x)
+        implicit[i] = -(G[i] @ x) <= tol
+    return implicit, (np.array(extra) if extra else np.zeros((0, P.G.shape[1])))
+
+
+def _rank(M, rel=1e-9):
+    if M.shape[0] == 0:
+        return 0
+    s = np.linalg.svd(M, compute_uv=False)
+    return int(np.sum(s > rel * max(s[0], 1e-300)))
+
+
+def lp_dimension(model, points, basis, tol, max_rounds=200):
+    """Affine rank of LP points of ``A ∩ C``, completed along the unspanned directions of
+    ``basis`` (orthonormal columns spanning the linear space of the affine hull found by the
+    rank count): each direction is maximized and minimized; a width ``<= tol`` marks it flat.
+    Returns ``(dimension, flat_directions)``."""
+    d = basis.shape[1]
+    pts = [p for p in points]
+    flat = 0
+    for _ in range(max_rounds):
+        X = np.array(pts) @ basis                  # coordinates in the hull's space
+        D = X - X.mean(axis=0)
+        if D.shape[0] > 1:
+            _, s, vt = np.linalg.svd(D, full_matrices=True)
+            r = int(np.sum(s > 1e-9 * max(s[0], 1e-300) + tol)) if len(s) else 0
+        else:
+            vt, r = np.eye(d), 0
+        if r + flat >= d:
+            return r, flat
+        v = vt[r + flat] if r + flat < vt.shape[0] else vt[-1]
+        u = basis @ v
+        x1, x2 = model.minimize(u), model.minimize(-u)
+        if abs(u @ (x2 - x1)) <= tol:
+            flat += 1
+        pts += [x1, x2]
+    return r, flat
+
+
+def exact_measures(H, F, mu, width_tol=1e-7, slack_tol=1e-9):
+    """Every exact measure of one packing -> dict (forces in force units)."""
+    P = ForcePolytope(H, F, mu)
+    k = P.n_contacts
+    Hd = P.A_eq.toarray()
+    rank_h = _rank(Hd)
+    model = _Model(P)
+    out = {"n_contacts": k, "rank_H": rank_h, "dim_A": 2 * k - rank_h, "n_equations": Hd.shape[0],
+           "scale": P.scale}
+    if model.minimize(np.zeros(2 * k)) is None:
+        raise PolytopeError("A ∩ C is empty: the packing is not in equilibrium")
+    out["bounded"] = P.is_bounded()
+    if not out["bounded"]:
+        raise PolytopeError("A ∩ C is unbounded (a self-stress inside C)")
+    lo, hi, points = force_ranges(P, model)
+    implicit, extra = implicit_rows(P, model, points, slack_tol)
+    E = np.vstack([Hd, P.G.toarray()[implicit]])
+    _, s, vt = np.linalg.svd(E)
+    rank_e = int(np.sum(s > 1e-9 * s[0]))
+    basis = vt[rank_e:].T
+    out["dim_AC_rank"] = 2 * k - rank_e
+    out["dim_AC_lp"], out["flat_directions"] = lp_dimension(model, np.vstack([points, extra]), basis,
+                                                            tol=width_tol)
+    width = hi - lo
+    mid = 0.5 * (hi + lo)
+    fixed = (width <= width_tol).all(axis=1)
+    out.update(
+        force_min=lo * P.scale, force_max=hi * P.scale, fixed=fixed, n_fixed=int(fixed.sum()),
+        implicit_zero=implicit[2 * k:], implicit_sliding=implicit[:k] | implicit[k:2 * k],
+        eta_exact=float(np.hypot(width[:, 0], width[:, 1]).sum() / np.hypot(mid[:, 0], mid[:, 1]).sum()),
+        eta_normal=float(width[:, 0].sum() / np.abs(mid[:, 0]).sum()),
+        n_lp=model.n_lp + P.n_lp)
+    return out
+
+
+def unger_eta(forces):
+    """Unger et al.'s measure from relaxed solutions ``forces`` (samples, contacts, 2),
+    the first the starting solution: ``<|F_k - F_0|> / <|F_0|>`` averaged over contacts,
+    then over samples ``k >= 1``."""
+    f = np.asarray(forces, float)
+    d = np.hypot(*(f[1:] - f[:1]).transpose(2, 0, 1)).mean(axis=1)
+    return float(d.mean() / np.hypot(f[0, :, 0], f[0, :, 1]).mean())
