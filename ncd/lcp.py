@@ -105,8 +105,8 @@ def _lemke(M, q, d, max_pivots, tol):
     return basis, 2, max_pivots
 
 
-def lemke(M, q, max_pivots=None, tol=1e-12):
-    """Solve LCP(M, q) by Lemke's method.
+def lemke(M, q, max_pivots=None, tol=1e-12, covering=None):
+    """Solve LCP(M, q) by Lemke's method (covering vector ``covering``, default all ones).
 
     Returns ``(z, info)``: ``z`` (None unless ``info["status"] == "solution"``)
     recomputed from the final complementary basis by a linear solve, and
@@ -122,13 +122,16 @@ def lemke(M, q, max_pivots=None, tol=1e-12):
         raise InputError("M and q must be finite")
     if not (np.isfinite(tol) and tol > 0):
         raise InputError(f"tol = {tol!r} must be > 0")
+    d = np.ones(n) if covering is None else np.ascontiguousarray(np.asarray(covering, dtype=float).ravel())
+    if d.shape != (n,) or not np.all(d > 0):
+        raise InputError(f"covering must be {n} positive numbers")
     max_pivots = 50 * n + 100 if max_pivots is None else int(max_pivots)
     if max_pivots < 1:
         raise InputError(f"max_pivots = {max_pivots} must be >= 1")
     if n == 0 or np.all(q >= 0):
         z = np.zeros(n)
         return z, {"status": "solution", "pivots": 0, "residual": lcp_residual(M, q, z)}
-    basis, status, pivots = _lemke(M, q, np.ones(n), max_pivots, tol)
+    basis, status, pivots = _lemke(M, q, d, max_pivots, tol)
     info = {"status": LEMKE_STATUS[int(status)], "pivots": int(pivots)}
     if status != 0:
         info["residual"] = np.nan

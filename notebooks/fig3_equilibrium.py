@@ -49,7 +49,10 @@ import numpy as np
 import xarray as xr
 from matplotlib.patches import Circle
 
+from IPython.display import Markdown
+
 from ncd.figures import equilibrium as fe
+from ncd.figures import faces
 from ncd.polytope import outside_distance
 
 from ncd.notebook import paths, save
@@ -170,8 +173,8 @@ d_ac = int(proj.attrs["dimension_AC"])
 fig, ax = plt.subplots(figsize=(6, 3.2))
 width = 0.2
 for i, (m, ds) in enumerate(list(subsets.items()) + [("uniform", uni)]):
-    pts = np.stack([ds.force_n.values, ds.force_t.values], -1).reshape(len(ds.force_n), -1)[:3000]
-    _, dims = P.active_faces(pts, tol=1e-9)
+    pts = np.stack([ds.force_n.values, ds.force_t.values], -1).reshape(len(ds.force_n), -1)
+    dims = faces.face_census(P, pts)[0]          # every run, not a sample
     frac = np.bincount(dims, minlength=d_ac + 1)[: d_ac + 1] / len(dims)
     ax.bar(np.arange(d_ac + 1) + (i - 1.5) * width, frac, width, color=colors[m], label=m)
     print(f"{m:>8}: face dimension distribution (0..{d_ac}):", np.round(frac, 3))
@@ -306,15 +309,13 @@ plt.show()
 # * **Warm start** (the impulses of the last deposition step): every run stops
 #   after one sweep at one point (spread $\sim 10^{-12}$ N), the "very little
 #   indeterminacy" of section 2. That point is interior to $A \cap C$.
-# * **Ghost images.** Every NLGS solution from a zero or random guess lies on a
-#   proper face of $A \cap C$ (dimension 1 to 6 out of 7, mostly 2 or 3): some
-#   contacts carry no force or slide at the Coulomb limit. A uniform point is interior with
+# * **Ghost images.** Measured over every run (next cell): where the NLGS
+#   solutions lie among the faces of $A \cap C$, which contacts carry no force
+#   and which slide at the Coulomb limit. A uniform point is interior with
 #   probability one. The lines inside the random-guess clouds are projections of
-#   such edges and faces, as Moreau suggests; but relative to a uniform law the
-#   NLGS points are not "a little denser" near the boundary: they are all *on*
-#   it. In the force plane the contrast is less simple (the fraction of points
-#   near the polygon's boundary depends on the contact), because a projection
-#   mixes faces and interior.
+#   faces, as Moreau suggests. In the force plane the contrast is less simple
+#   (the fraction of points near the polygon's boundary depends on the contact),
+#   because a projection mixes faces and interior.
 # * **Differences.** The paper gives neither its packing nor its friction
 #   coefficient, time step or tolerance; ours are stated in `config.yaml`
 #   ($\mu = 0.5$ as in section 3 for discs and walls). Its packing is not
@@ -323,3 +324,9 @@ plt.show()
 #   mobile discs not sharing a disc. We draw each force in its contact's local
 #   frame $(r_t, r_n)$; the paper draws "a dot at the extremity" of each force,
 #   presumably as a vector in the plane of the packing.
+
+# %%
+# Ghost images, measured over every run of each mode (ncd.figures.faces)
+face_modes = {m: np.stack([ds.force_n.values, ds.force_t.values], -1).reshape(len(ds.force_n), -1)
+              for m, ds in subsets.items()}
+Markdown(faces.face_text(faces.face_summary(P, face_modes)))

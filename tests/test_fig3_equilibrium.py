@@ -115,6 +115,21 @@ def test_active_faces_and_polygon_helpers():
     np.testing.assert_allclose(boundary_distance([[0.5, 0.5], [0.9, 0.5], [2, 0.5]], square), [0.5, 0.1, -1.0])
 
 
+def test_face_census_of_the_shared_load():
+    """The triangle problem of _shared_load: a vertex (contact 1 sliding at full load,
+    contact 2 without force), an interior point, and a point where both slide."""
+    from ncd.figures import faces
+    mu = 0.5
+    P = _shared_load(mu)
+    pts = np.array([[1.0, mu, 0.0, 0.0], [0.5, 0.0, 0.5, 0.0], [0.5, 0.25, 0.5, -0.25]])
+    dims, free, slide = faces.face_census(P, pts)
+    assert list(dims) == [0, 3, 1] and list(free) == [1, 0, 0] and list(slide) == [1, 0, 2]
+    s = faces.face_summary(P, {"zero": pts[:2], "random": pts[1:2]})
+    assert s["zero"]["interior"] == 1 and s["zero"]["with_free"] == 1 and s["random"]["interior"] == 1
+    text = faces.face_text(s)
+    assert "1 lie on a proper face" in text and "1 is interior" in text and "at most 1" in text
+
+
 # ---------------------------------------------------------------- the figure data
 @pytest.fixture(scope="module")
 def fig3(results):
@@ -165,6 +180,22 @@ def test_cloud_measures_of_the_displayed_contacts(fig3):
         assert rows[k, "warm"]["spread"] <= 1e-2 * rows[k, "zero"]["spread"]
         for m in ("zero", "random", "uniform"):
             assert 0 < rows[k, m]["coverage"] <= 1 + 1e-6
+
+
+def test_face_statements_over_every_run(fig3):
+    """The notebook's face statements are measured over all runs: every zero-guess run on a
+    proper face, the warm runs interior, and the text says what the counts say."""
+    from ncd.figures import faces
+    ens, P = fig3["ensemble"], fig3["P"]
+    modes = {m: np.stack([fe.mode_subset(ens, m).force_n.values, fe.mode_subset(ens, m).force_t.values],
+                         -1).reshape(fe.mode_subset(ens, m).sizes["run"], -1) for m in fe.MODES}
+    s = faces.face_summary(P, modes)
+    assert sum(v["runs"] for v in s.values()) == ens.sizes["run"]
+    assert s["zero"]["interior"] <= 0.01 * s["zero"]["runs"]
+    assert s["warm"]["interior"] == s["warm"]["runs"]
+    text = faces.face_text(s)
+    for m in ("zero", "random"):
+        assert f"{s[m]['runs']} {m}-guess runs" in text
 
 
 def test_uniform_points_are_equilibria(fig3):

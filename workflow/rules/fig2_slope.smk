@@ -5,6 +5,8 @@
 #              block of members, tolerance by tolerance   -> shards/ensemble_<k>-of-<n>.nc
 #   merge      the shards, in member order                -> ensemble.nc
 #   analyse    spreads, principal axes, solutions, verdict -> measures.nc
+#   census     exact solutions: NLGS end points, Lemke,
+#              status enumeration, basins, stability     -> census.nc
 #   notebook   notebooks/fig2_slope.ipynb                  -> results/figures/fig2_slope.png|pdf
 FIG2 = "fig2_slope"
 CFG2 = section(FIG2)
@@ -88,6 +90,24 @@ rule fig2_slope_analyse:
         CONDA_ENV
     script:
         "../scripts/fig2_slope_analyse.py"
+
+
+rule fig2_slope_census:
+    input:
+        ncd_sources(FIG2),
+        trajectory=f"{F2}/trajectory.nc",
+        ensemble=f"{F2}/ensemble.nc",
+        measures=f"{F2}/measures.nc",
+    output:
+        f"{F2}/census.nc",
+    params:
+        config={k: CFG2[k] for k in ("scene", "flow", "census")},
+    log:
+        log(FIG2, "census"),
+    benchmark:
+        bench(FIG2, "census")
+    script:
+        "../scripts/fig2_slope_census.py"
 
 
 rule fig2_slope_notebook:

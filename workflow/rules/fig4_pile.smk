@@ -2,6 +2,8 @@
 # resultant across a vertical cut and its indetermination cloud.
 #   simulate   pour, settle until the warm equilibrium test passes -> construction.nc
 #   cuts       surface fit, cuts and ground pressure (history)     -> cuts.nc
+#   exact      A ∩ C by LP (HiGHS): cut polygons, angle
+#              ranges, ground-pressure bands, dip verdict   -> exact.nc
 #   explore    zero-guess NLGS runs (random orders) of one shard of
 #              the ensemble or of the tolerance study               -> shards/<name>_<k>-of-<n>.nc
 #   merge      the shards, in member order                          -> ensemble.nc, tolerance.nc
@@ -13,6 +15,7 @@ F4 = f"results/{FIG4}"
 CFG4_SIM = {k: CFG4[k] for k in ("seed", "grains", "ground", "mu", "mu_ground", "gravity", "h", "source",
                                  "construction")}
 CFG4_CUTS = {**CFG4_SIM, **{k: CFG4[k] for k in ("surface", "cut", "pressure")}}
+CFG4_EXACT = {**CFG4_CUTS, "exact": CFG4["exact"]}
 CFG4_EXP = {**CFG4_CUTS, **{k: CFG4[k] for k in ("ensemble", "tolerance_study")}}
 F4_SHARDS = {"ensemble": CFG4["ensemble"]["shards"], "tolerance": CFG4["tolerance_study"]["shards"]}
 
@@ -50,6 +53,23 @@ rule fig4_pile_cuts:
         CONDA_ENV
     script:
         "../scripts/fig4_pile_cuts.py"
+
+
+rule fig4_pile_exact:
+    input:
+        ncd_sources(FIG4),
+        construction=f"{F4}/construction.nc",
+        cuts=f"{F4}/cuts.nc",
+    output:
+        f"{F4}/exact.nc",
+    params:
+        config=CFG4_EXACT,
+    log:
+        log(FIG4, "exact"),
+    benchmark:
+        bench(FIG4, "exact")
+    script:
+        "../scripts/fig4_pile_exact.py"
 
 
 rule fig4_pile_explore:

@@ -1,0 +1,320 @@
+"""Figure 2, exactly: a census of the solutions of the investigated step (Moreau 2005, section 3).
+
+NLGS from the zero guess reaches a few end points; that does not say how many
+solutions the step has.  The census gathers exact solutions from four sources,
+each polished on its contact statuses to a relative natural-map residual
+``<= polish_tol`` (:func:`ncd.finish.project_statuses`, minimum-norm correction):
+
+* ``nlgs``: the distinct end points of the figure's ensemble (zero-guess and
+  warm-start runs at the tightest tolerance) and of ``random_runs`` NLGS runs
+  from random guesses;
+* ``lemke``: Lemke's method (:mod:`ncd.lcp`) on the LCP form of the step (size
+  ``3 kappa``), with the covering vector ``1`` and ``lemke_runs - 1`` random ones
+  (each covering vector follows its own complementary path);
+* ``enumeration``: on the contacts whose status differs between two solutions
+  found, every combination of their two statuses (when there are at most
+  ``max_patterns``), and the combinations of the changes from one solution to
+  two others (:func:`enumerate_statuses`), each solved on its statuses and kept
+  when the result satisfies the contact law.
+
+Solutions are distinct when their acceleration fields differ by more than
+``same_tol |g|``.  Per solution: its basin (how many zero-guess, warm-start and
+random-guess runs end within ``basin_tol |g|`` of it) and its stability (NLGS
+restarted from it plus a relative perturbation ``noise``, ``perturb_runs`` times,
+returns to it within ``basin_tol``).
+"""
+import itertools
+import time
+
+import numpy as np
+import xarray as xr
+
+from ..explore import explore
+from ..finish import check_solution, global_delassus, natural_map, project_statuses, relative_residual
+from ..io import provenance
+from ..lcp import frictional_lcp, impulse_of_lcp, lemke
+from ..local_solver import STICK, SLIDE_BACKWARD
+from ..nlgs import SolverSettings
+from ..stepper import prepare_step, solve_problem
+
+METHODS = ("nlgs", "lemke", "enumeration")
+
+
+class StepSolutions:
+    """The core problem of one step in local form ``U = W s + q`` with its disc velocities."""
+
+    def __init__(self, scene, problem):
+        c = problem.contacts
+        self.scene, self.problem, self.h, self.nm = scene, problem, problem.h, scene.n_mobile
+        self.W, self.H, self.minv = global_delassus(scene, c)
+        nm = self.nm
+        self.free = np.column_stack([problem.free_vel[:nm], problem.free_spin[:nm]]).ravel()
+        self.q = (self.H.T @ self.free).reshape(-1, 2) + problem.bias
+        self.mu = c.mu
+        self.rho = 1.0 / self.W.diagonal()[0::2]
+        self.scale = float(np.sqrt(np.sum((self.q * self.rho[:, None]) ** 2)))
+        self.g = float(np.linalg.norm(scene.gravity))
+
+    def U(self, s):
+        return (self.W @ np.asarray(s).ravel()).reshape(-1, 2) + self.q
+
+    def residual(self, s):
+        return relative_residual(np.asarray(s).reshape(-1, 2), self.U(s), self.mu, self.rho, self.scale)
+
+    def status(self, s):
+        return natural_map(np.asarray(s).reshape(-1, 2), self.U(s), self.mu, self.rho)[1]
+
+    def accel(self, s):
+        """Accelerations (nm, 2) of the grains: ``(u_f - u_i) / h``."""
+        u = (self.free + self.minv * (self.H @ np.asarray(s).ravel())).reshape(-1, 3)
+        return (u[:, :2] - self.problem.vel_initial[:self.nm]) / self.h
+
+    def polish(self, s, status=None, tol=1e-12, rounds=12):
+        """Project ``s`` on the affine set of its statuses, re-read them, repeat:
+        ``(s, residual)`` of the best iterate (residual ``<= tol`` when it succeeded)."""
+        s = np.asarray(s, float).reshape(-1, 2)
+        status = self.status(s) if status is None else np.where(status > SLIDE_BACKWARD, STICK, status)
+        best = (self.residual(s), s)
+        for _ in range(rounds):
+            s = project_statuses(self.W, self.q.ravel(), self.mu, s, status.astype(np.int8))
+            res = self.residual(s)
+            if res < best[0]:
+                best = (res, s)
+            if res <= tol:
+                break
+            new = self.status(s)
+            if np.array_equal(new, status):
+                break
+            status = new
+        return best[1], best[0]
+
+
+class Census:
+    """Distinct exact solutions, each with the methods that found it."""
+
+    def __init__(self, step, same_tol):
+        self.step, self.same = step, same_tol * step.g
+        self.impulse, self.accel, self.found = [], [], []
+
+    def add(self, s, method, polish_tol):
+        """Polish ``s``; keep it if it is a solution; returns its index or -1."""
+        s, res = self.step.polish(s, tol=polish_tol)
+        if res > polish_tol:
+            return -1
+        a = self.step.accel(s)
+        for k, b in enumerate(self.accel):
+            if np.abs(a - b).max() <= self.same:
+                self.found[k].add(method)
+                return k
+        self.impulse.append(s)
+        self.accel.append(a)
+        self.found.append({method})
+        return len(self.accel) - 1
+
+    def nearest(self, accel, tol):
+        """Index of the solution within ``tol`` (max norm) of each field, -1 if none."""
+        out = np.full(len(accel), -1)
+        A = np.array(self.accel)
+        for r, a in enumerate(accel):
+            d = np.abs(A - a[None]).reshape(len(A), -1).max(1)
+            if d.min() <= tol:
+                out[r] = int(np.argmin(d))
+        return out
+
+
+def _try(step, census, base, status, ptol):
+    s = project_statuses(step.W, step.q.ravel(), step.mu, base, status.astype(np.int8))
+    return census.add(s, "enumeration", ptol) if step.residual(s) <= 1e-8 else -1
+
+
+def enumerate_statuses(step, census, max_patterns, ptol, rounds=2):
+    """Solve the step on status patterns built from the solutions found; yields the
+    census index of each pattern's solution (-1: the pattern gives none).
+
+    For every ordered pair ``(i, j)`` of solutions whose statuses differ at ``k``
+    contacts with ``2^k <= max_patterns``: the ``2^k`` patterns taking at each of
+    those contacts the status of ``i`` or of ``j``, from ``i``'s impulses.  Then,
+    for every solution ``i`` and pair ``j < k``, the pattern combining the status
+    changes from ``i`` to ``j`` and from ``i`` to ``k``.  Repeated for ``rounds``
+    while new solutions appear."""
+    done = set()
+    for _ in range(rounds):
+        n0 = len(census.impulse)
+        st = [step.status(s) for s in census.impulse]
+        for i in range(n0):
+            for j in range(n0):
+                sw = np.nonzero(st[i] != st[j])[0]
+                if i == j or (i, j) in done or 2 ** len(sw) > max_patterns:
+                    continue
+                done.add((i, j))
+                for bits in itertools.product((False, True), repeat=len(sw)):
+                    status = st[i].copy()
+                    status[sw] = np.where(bits, st[j][sw], st[i][sw])
+                    yield _try(step, census, census.impulse[i], status, ptol)
+            for j, k in itertools.combinations([m for m in range(n0) if m != i], 2):
+                if (i, j, k) in done:
+                    continue
+                done.add((i, j, k))
+                status = st[i].copy()
+                for m in (j, k):
+                    status[st[m] != st[i]] = st[m][st[m] != st[i]]
+                yield _try(step, census, census.impulse[i], status, ptol)
+        if len(census.impulse) == n0:
+            break
+
+
+def nlgs_end_points(ens, measures):
+    """Impulses of one run per distinct NLGS end point of the ensemble (tightest tolerance)."""
+    labels = measures["solution_label"].values.ravel()
+    imp = np.stack([ens.impulse_n.values, ens.impulse_t.values], -1).reshape(-1, ens.sizes["contact"], 2)
+    return [imp[int(np.nonzero(labels == k)[0][0])] for k in range(int(labels.max()) + 1)]
+
+
+def run_census(traj, ens, measures, cfg, log=None):
+    """The census of the investigated step: a dict of arrays and counts (see :func:`census_dataset`)."""
+    from .slope import scene_at_step
+    cc = cfg["census"]
+    scene = scene_at_step(traj, cfg)
+    problem = prepare_step(scene, float(traj.attrs["h"]))
+    step = StepSolutions(scene, problem)
+    census = Census(step, cc["same_tol"])
+    ptol = cc["polish_tol"]
+    times = {}
+    t0 = time.perf_counter()
+    per_method = {m: set() for m in METHODS}
+    for s in nlgs_end_points(ens, measures):
+        k = census.add(s, "nlgs", ptol)
+        if k >= 0:
+            per_method["nlgs"].add(k)
+    # random-guess NLGS runs
+    s_scale = float(np.abs(np.array(census.impulse)[..., 0]).max()) if census.impulse else 1.0
+    settings = SolverSettings(tol=cc["random_tol"], max_sweeps=cc["max_sweeps"], check_every=10)
+    rnd = explore(scene, problem, np.arange(cc["random_runs"]), cc["root_seed"], init="random",
+                  guess_scale=s_scale, settings=settings)
+    for s in rnd["impulse"][rnd["converged"]]:
+        k = census.add(s, "nlgs", ptol)
+        if k >= 0:
+            per_method["nlgs"].add(k)
+    times["nlgs"] = time.perf_counter() - t0
+    # Lemke with several covering vectors
+    t0 = time.perf_counter()
+    M, b = frictional_lcp(step.W.toarray(), step.q, step.mu)
+    lemke_info = []
+    for j in range(cc["lemke_runs"]):
+        d = np.ones(len(b)) if j == 0 else np.random.default_rng((j, cc["root_seed"])).uniform(0.5, 1.5, len(b))
+        x, info = lemke(M, b, covering=d)
+        lemke_info.append(info)
+        k = census.add(impulse_of_lcp(x, step.mu), "lemke", ptol) if x is not None else -1
+        if k >= 0:
+            per_method["lemke"].add(k)
+        if log is not None:
+            log.info("Lemke %d: %s after %d pivots, LCP residual %.2g -> solution %d", j, info["status"],
+                     info["pivots"], info["residual"], k)
+    times["lemke"] = time.perf_counter() - t0
+    # status enumeration on the contacts that switch between the solutions found
+    t0 = time.perf_counter()
+    switching = np.nonzero((np.array([step.status(s) for s in census.impulse]) != step.status(census.impulse[0]))
+                           .any(0))[0]
+    n_patterns = 0
+    for k in enumerate_statuses(step, census, cc["max_patterns"], ptol):
+        n_patterns += 1
+        if k >= 0:
+            per_method["enumeration"].add(k)
+    times["enumeration"] = time.perf_counter() - t0
+    # basins: the ensemble's runs and the random-guess runs
+    tight = ens.isel(tol=-1)
+    acc = np.stack([tight.accel_x.values, tight.accel_y.values], -1)          # init, run, disc, 2
+    basin_tol = cc["basin_tol"] * step.g
+    label_ens = np.stack([census.nearest(acc[i], basin_tol) for i in range(acc.shape[0])])
+    ok_ens = tight.converged.values.astype(bool)
+    acc_rnd = np.array([step.accel(s) for s in rnd["impulse"]])
+    label_rnd = census.nearest(acc_rnd, basin_tol)
+    label_rnd[~rnd["converged"]] = -2
+    # stability under perturbation
+    n_sol = len(census.accel)
+    returns = np.zeros(n_sol, np.int64)
+    pset = SolverSettings(tol=cc["perturb_tol"], max_sweeps=cc["max_sweeps"], check_every=10)
+    for k, s in enumerate(census.impulse):
+        for j in range(cc["perturb_runs"]):
+            rng = np.random.default_rng((k, j, cc["root_seed"]))
+            guess = s + cc["noise"] * np.abs(s).max() * rng.standard_normal(s.shape)
+            res, vel, _ = solve_problem(scene, problem, guess, rng.permutation(len(s)), pset)
+            a = (vel[:step.nm] - problem.vel_initial[:step.nm]) / step.h
+            returns[k] += bool(res.converged and np.abs(a - census.accel[k]).max() <= basin_tol)
+    # the straight segment between the two most visited NLGS solutions
+    seg_t = np.array(cc["segment_points"])
+    counts = np.array([(label_ens == k).sum() for k in range(n_sol)])
+    pair = np.argsort(-counts, kind="stable")[:2]
+    seg = np.full(len(seg_t), np.nan)
+    if n_sol >= 2:
+        s0, s1 = census.impulse[pair[0]], census.impulse[pair[1]]
+        seg = np.array([step.residual((1 - t) * s0 + t * s1) for t in seg_t])
+    checks = [check_solution(s, step.U(s), step.mu) for s in census.impulse]
+    return {"step": step, "census": census, "per_method": per_method, "label_ens": label_ens, "ok_ens": ok_ens,
+            "label_rnd": label_rnd, "returns": returns, "segment_t": seg_t, "segment_residual": seg,
+            "segment_pair": pair, "switching": switching, "n_patterns": n_patterns, "lemke_info": lemke_info,
+            "checks": checks, "times": times, "random_scale": s_scale,
+            "statuses": np.array([step.status(s) for s in census.impulse])}
+
+
+def census_dataset(traj, ens, measures, cfg, log=None):
+    """census.nc: the distinct exact solutions of the investigated step, how each was
+    found, its basin among the NLGS runs, its stability and the chosen grain's acceleration."""
+    out = run_census(traj, ens, measures, cfg, log)
+    step, census = out["step"], out["census"]
+    n = len(census.accel)
+    grain = int(measures.attrs["grain"])
+    A = np.array(census.accel)
+    S = np.array(census.impulse)
+    found = np.array([[m in f for m in METHODS] for f in census.found], np.int8).reshape(n, len(METHODS))
+    inits = list(ens.init.values)
+    basin = {f"n_{init}": ("solution", np.array([int(((out["label_ens"][i] == k) & out["ok_ens"][i]).sum())
+                                                  for k in range(n)]),
+                           {"units": "1", "long_name": f"{init} NLGS runs (tightest tolerance) ending on the solution"})
+             for i, init in enumerate(inits)}
+    cc = cfg["census"]
+    flag = {"units": "1", "flag_values": np.array([0, 1], np.int8), "flag_meanings": "no yes"}
+    ds = xr.Dataset(
+        {
+            "accel_x": (("solution", "disc"), A[..., 0], {"units": "m s-2", "long_name": "grain acceleration (u_f - u_i)/h, x"}),
+            "accel_y": (("solution", "disc"), A[..., 1], {"units": "m s-2", "long_name": "grain acceleration (u_f - u_i)/h, y"}),
+            "impulse_n": (("solution", "contact"), S[..., 0], {"units": "N s", "long_name": "normal impulse (minimum-norm representative)"}),
+            "impulse_t": (("solution", "contact"), S[..., 1], {"units": "N s", "long_name": "tangential impulse (minimum-norm representative)"}),
+            "status": (("solution", "contact"), out["statuses"], {"units": "1", "long_name": "contact status",
+                                                                 "flag_values": np.arange(4, dtype=np.int8),
+                                                                 "flag_meanings": "no_contact stick slide_forward slide_backward"}),
+            "residual": ("solution", np.array([step.residual(s) for s in S]), {"units": "1", "long_name": "relative natural-map residual of the polished solution"}),
+            "law_violation": ("solution", np.array([max(v for k, v in c.items() if k != "ok") for c in out["checks"]]),
+                              {"units": "1", "long_name": "largest componentwise violation of the Signorini-Coulomb law (relative)"}),
+            **{f"by_{m}": ("solution", found[:, j], {**flag, "long_name": f"found by {m}"}) for j, m in enumerate(METHODS)},
+            **basin,
+            "n_random": ("solution", np.array([int((out["label_rnd"] == k).sum()) for k in range(n)]),
+                         {"units": "1", "long_name": "random-guess NLGS runs ending on the solution"}),
+            "returns": ("solution", out["returns"], {"units": "1", "long_name": f"perturbed restarts (of {cc['perturb_runs']}) returning to the solution"}),
+            "grain_accel_x": ("solution", A[:, grain, 0], {"units": "m s-2", "long_name": "acceleration of the chosen grain, x"}),
+            "grain_accel_y": ("solution", A[:, grain, 1], {"units": "m s-2", "long_name": "acceleration of the chosen grain, y"}),
+            "n_switched": ("solution", (out["statuses"] != out["statuses"][0]).sum(1) if n else np.zeros(0, int),
+                           {"units": "1", "long_name": "contacts whose status differs from solution 0"}),
+            "n_grains_differ": ("solution", (np.hypot(*(A - A[:1]).transpose(2, 0, 1)) > cc["grain_differ"] * step.g).sum(1) if n else np.zeros(0, int),
+                                {"units": "1", "long_name": f"grains whose acceleration differs from solution 0 by more than {cc['grain_differ']} |g|"}),
+            "segment_residual": ("segment_t", out["segment_residual"], {"units": "1", "long_name": "residual of (1-t) s_a + t s_b between the two most visited NLGS solutions"}),
+            "switching": ("switching_contact", out["switching"], {"units": "1", "long_name": "contacts whose status differs between the solutions found before enumeration"}),
+        },
+        coords={"solution": np.arange(n), "disc": np.arange(step.nm), "contact": np.arange(step.problem.contacts.n),
+                "segment_t": out["segment_t"], "switching_contact": np.arange(len(out["switching"]))},
+        attrs=provenance(cfg["census"], grain=grain, g=step.g, n_solutions=n,
+                         **{f"n_{m}": len(out["per_method"][m]) for m in METHODS},
+                         n_patterns=out["n_patterns"], segment_pair=out["segment_pair"].astype(np.int64),
+                         random_guess_scale=out["random_scale"],
+                         random_converged=int((out["label_rnd"] != -2).sum()),
+                         lemke_status=";".join(f"{i['status']} ({i['pivots']} pivots)" for i in out["lemke_info"])),
+    )
+    for k, (u, ln) in {"solution": ("1", "exact solution index"), "disc": ("1", "grain index"),
+                       "contact": ("1", "contact index"), "segment_t": ("1", "position on the segment"),
+                       "switching_contact": ("1", "switching contact index")}.items():
+        ds[k].attrs.update(units=u, long_name=ln)
+    if log is not None:
+        log.info("census: %d distinct solutions (nlgs %d, lemke %d, enumeration %d; %d patterns), seconds %s",
+                 n, *(len(out["per_method"][m]) for m in METHODS), out["n_patterns"],
+                 {k: round(v, 1) for k, v in out["times"].items()})
+    return ds

@@ -1,0 +1,279 @@
+"""Figure 4, exactly: the set A ∩ C of the pile's final configuration (Moreau 2005, sections 4-5).
+
+The equilibrium forces of the final arrangement form the polytope
+``A ∩ C = {r : H r + F = 0, |r_t| <= mu r_n}`` (:class:`ncd.polytope.ForcePolytope`
+builds its scaled equations and Coulomb rows).  Every quantity of the figure is a
+linear map of ``r`` (cut resultants, ground forces), so its exact range over
+A ∩ C is given by linear programs.  :class:`ExactSet` keeps one sparse HiGHS
+model (``highspy``) and changes only its objective between queries, so that
+each LP restarts from the previous optimal basis:
+
+* :meth:`ExactSet.polygon`: the exact projection of A ∩ C under a 2-row map
+  (a cut resultant) -- ``n_dirs`` support directions evenly spread, then every
+  hull edge tested along its outer normal until inner and outer polygons agree;
+* :meth:`ExactSet.interval`: the exact min and max of one linear functional
+  (a ground-pressure value, a dip depth, the vertical component of a resultant).
+
+:func:`exact_dataset` applies them to the pile (``exact.nc``): the polygons of
+the default cut and of the cuts moved by ``± shift_d``, per cut of both flanks
+the exact range of the resultant's angle below the horizontal and of its
+vertical component (a state *arches* across a cut when the inner side pushes the
+bank downward, ``F_y < 0``: every admissible state arches iff ``max F_y < 0``),
+and the exact range of the ground pressure (:mod:`ncd.figures.pressure`).
+"""
+import time
+
+import highspy
+import numpy as np
+import scipy.sparse as sp
+import xarray as xr
+
+from ..contacts import h_matrix
+from ..io import provenance
+from ..polytope import ForcePolytope, PolytopeError, clip_polygon, convex_hull, polygon_area
+from . import cuts as cm
+
+FEAS_TOL = 1e-10
+
+
+class ExactSet:
+    """A ∩ C of ``H r + F = 0`` (r: 2 kappa forces) with Coulomb cones, as one HiGHS model."""
+
+    def __init__(self, H, F, mu):
+        self.fp = fp = ForcePolytope(H, F, mu)
+        self.scale, self.n = fp.scale, 2 * fp.n_contacts
+        A = sp.vstack([fp.A_eq, fp.G]).tocsc()
+        m_eq, m_ub = fp.A_eq.shape[0], fp.G.shape[0]
+        lp = highspy.HighsLp()
+        lp.num_col_, lp.num_row_ = self.n, A.shape[0]
+        inf = highspy.kHighsInf
+        lp.col_cost_ = np.zeros(self.n)
+        lp.col_lower_ = np.full(self.n, -inf)
+        lp.col_upper_ = np.full(self.n, inf)
+        lp.row_lower_ = np.concatenate([fp.b_eq, np.full(m_ub, -inf)])
+        lp.row_upper_ = np.concatenate([fp.b_eq, np.zeros(m_ub)])
+        lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
+        lp.a_matrix_.start_ = A.indptr
+        lp.a_matrix_.index_ = A.indices
+        lp.a_matrix_.value_ = A.data
+        h = highspy.Highs()
+        h.silent()
+        for k, v in (("primal_feasibility_tolerance", FEAS_TOL), ("dual_feasibility_tolerance", FEAS_TOL),
+                     ("threads", 1), ("random_seed", 0), ("simplex_strategy", 4)):
+            h.setOptionValue(k, v)
+        h.passModel(lp)
+        self.highs, self.n_lp, self.lp_time = h, 0, 0.0
+        self._cols = np.arange(self.n, dtype=np.int32)
+
+    def minimize(self, c):
+        """``(min c . r, r)`` over A ∩ C (``c`` in force units, ``r`` forces)."""
+        t0 = time.perf_counter()
+        self.highs.changeColsCost(self.n, self._cols, np.asarray(c, dtype=float) * self.scale)
+        self.highs.run()
+        status = self.highs.getModelStatus()
+        self.n_lp += 1
+        self.lp_time += time.perf_counter() - t0
+        if status == highspy.HighsModelStatus.kInfeasible:
+            raise PolytopeError("A ∩ C is empty: no contact forces balance the weights")
+        if status != highspy.HighsModelStatus.kOptimal:
+            raise PolytopeError(f"LP not solved: {self.highs.modelStatusToString(status)}")
+        r = np.asarray(self.highs.getSolution().col_value) * self.scale
+        return float(np.dot(c, r)), r
+
+    def interval(self, c):
+        """Exact ``(min, max)`` of ``c . r`` over A ∩ C."""
+        lo = self.minimize(c)[0]
+        hi = -self.minimize(-np.asarray(c, dtype=float))[0]
+        return lo, hi
+
+    def intervals(self, rows):
+        """Exact ``(min, max)`` of each row of a sparse matrix over A ∩ C, shape (m, 2).
+
+        All minima first, then all maxima, in row order: neighbouring rows (a
+        pressure profile) have neighbouring optima, so each LP restarts close by."""
+        rows = sp.csr_matrix(rows)
+        out = np.empty((rows.shape[0], 2))
+        for j, sign in ((0, 1.0), (1, -1.0)):
+            for i in range(rows.shape[0]):
+                out[i, j] = sign * self.minimize(sign * rows[i].toarray().ravel())[0]
+        return out
+
+    def polygon(self, L, n_dirs=180, tol=1e-9, max_lp=4000):
+        """Exact image of A ∩ C under the (2, 2 kappa) map ``L``: a convex polygon.
+
+        Support points in ``n_dirs`` evenly spread directions, then each edge of
+        their hull tested along its outer normal (a point beyond it by more than
+        ``tol`` times the force scale is added) until every edge is confirmed.
+        Returns ``vertices`` (ccw), ``inner_area``, ``outer_area`` (the polygon
+        of all supporting half-planes), ``n_lp``, ``exact`` and ``points`` (the
+        support points' full force vectors, one per LP).
+        """
+        L = sp.csr_matrix(L)
+        eps = tol * self.scale
+        normals, values, pts, full = [], [], [], []
+
+        def query(u):
+            c = -(L.T @ u)
+            _, r = self.minimize(c)
+            p = L @ r
+            normals.append(u)
+            values.append(float(u @ p))
+            pts.append(p)
+            full.append(r)
+            return p
+
+        for a in 2 * np.pi * np.arange(n_dirs) / n_dirs:
+            query(np.array([np.cos(a), np.sin(a)]))
+        confirmed, exact, n_lp = set(), False, n_dirs
+        while n_lp < max_lp:
+            hull = convex_hull(pts, tol=eps)
+            if len(hull) < 3:
+                exact = True           # a point or a segment, met from every direction
+                break
+            todo = [(hull[k], hull[(k + 1) % len(hull)]) for k in range(len(hull))]
+            todo = [(a, b) for a, b in todo if (tuple(a), tuple(b)) not in confirmed]
+            if not todo:
+                exact = True
+                break
+            for a, b in todo:
+                e = b - a
+                u = np.array([e[1], -e[0]]) / np.hypot(*e)
+                q = query(u)
+                n_lp += 1
+                if u @ q <= u @ a + eps:
+                    confirmed.add((tuple(a), tuple(b)))
+        hull = convex_hull(pts, tol=eps)
+        span = max(np.ptp(np.array(pts), axis=0).max(), self.scale)
+        box = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]]) * 10 * span + np.array(pts).mean(0)
+        outer = clip_polygon(box, normals, np.array(values) + eps)
+        return {"vertices": hull, "inner_area": polygon_area(hull), "outer_area": polygon_area(outer),
+                "n_lp": n_lp, "exact": bool(exact), "points": np.array(full)}
+
+
+def pile_problem(cfg, construction):
+    """``(scene, contacts, H, F, mu)`` of the final configuration: ``H r + F = 0`` (forces)."""
+    from .pile import equilibrium_problem, final_scene
+    scene = final_scene(cfg, construction)
+    c = equilibrium_problem(cfg, scene, construction).contacts
+    nm = scene.n_mobile
+    F = np.zeros((nm, 3))
+    F[:, :2] = scene.mass[:nm, None] * scene.gravity[None, :]
+    return scene, c, h_matrix(scene, c), F.ravel(), c.mu
+
+
+def resultant_angle(vertices, outer):
+    """Range of the angle below the horizontal (degrees, pointing outward) of the
+    resultants of a convex polygon not containing the origin (nan, nan if it does)."""
+    v = np.asarray(vertices, float).reshape(-1, 2)
+    from ..polytope import outside_distance
+    if len(v) >= 3 and outside_distance(np.zeros((1, 2)), v)[0] == 0.0:
+        return np.nan, np.nan
+    phi = np.degrees(np.arctan2(-v[:, 1], outer * v[:, 0]))
+    # the polygon subtends less than 180 degrees: unwrap around the mean direction
+    ref = np.degrees(np.arctan2(-v[:, 1].mean(), outer * v[:, 0].mean()))
+    d = (phi - ref + 180.0) % 360.0 - 180.0
+    return float(ref + d.min()), float(ref + d.max())
+
+
+def _pad(arrays, width):
+    """Stack ragged (k, 2) arrays into (n, width, 2) padded with NaN."""
+    out = np.full((len(arrays), width, 2), np.nan)
+    for i, a in enumerate(arrays):
+        out[i, :len(a)] = a
+    return out
+
+
+def exact_dataset(cfg, construction, cuts, log=None):
+    """exact.nc: polygons of the default and shifted cuts, the exact angle range and
+    arching of every cut, the exact ground-pressure bands and the dip verdict."""
+    from . import pressure as pm
+    from .pile import _cut_specs, mean_diameter
+    ex = cfg["exact"]
+    scene, c, H, F, mu = pile_problem(cfg, construction)
+    nm, d = scene.n_mobile, mean_diameter(cfg)
+    weight = float(construction.attrs["weight"])
+    history = np.column_stack([construction["force_n"].values, construction["force_t"].values]).ravel()
+    t0 = time.perf_counter()
+    es = ExactSet(H, F, mu)
+    C, _ = cm.cut_matrix(c, scene.pos, nm, _cut_specs(cuts))
+    kind, outer = cuts["kind"].values, cuts["outer"].values
+    # (a) the polygons of the default and shifted cuts, (b) every cut's exact polygon
+    polys, n_lp, exact, walls = [], [], [], []
+    for k in range(len(kind)):
+        n_dirs = ex["n_dirs"] if kind[k] != "scan" else ex["scan_dirs"]
+        t1 = time.perf_counter()
+        p = es.polygon(C[2 * k: 2 * k + 2], n_dirs=n_dirs, tol=ex["tol"])
+        walls.append(time.perf_counter() - t1)
+        polys.append(p["vertices"])
+        n_lp.append(p["n_lp"])
+        exact.append(p["exact"])
+        if k == 0:
+            eq, co = es.fp.violations(p["points"])
+            vertex_check = (float(eq.max()), float(co.max()))
+        if log is not None and kind[k] != "scan":
+            log.info("cut %d (%s): %d vertices, %d LPs, %.1f s", k, kind[k], len(p["vertices"]), p["n_lp"],
+                     walls[-1])
+    angle = np.array([resultant_angle(v, o) for v, o in zip(polys, outer)])
+    fy_max = np.array([v[:, 1].max() for v in polys])
+    fy_min = np.array([v[:, 1].min() for v in polys])
+    hist_F = (C @ history).reshape(-1, 2)
+    from ..polytope import outside_distance
+    hist_out = np.array([outside_distance(hist_F[k:k + 1], polys[k])[0] for k in range(len(kind))])
+    # (c) ground pressure: the bins of cuts.nc and a kernel average on a grid
+    edges = np.append(cuts["bin_lo"].values, cuts["bin_hi"].values[-1])
+    B = pm.bin_matrix(c, nm, edges)
+    xg = ex["grid_d"] * d * np.arange(-int(ex["grid_half_d"] / ex["grid_d"]), int(ex["grid_half_d"] / ex["grid_d"]) + 1)
+    K = pm.kernel_matrix(c, nm, xg, ex["kernel_d"] * d)
+    band_bin = es.intervals(B)
+    band_kernel = es.intervals(K)
+    # the dip: depth per analysis choice, history values, exact ranges
+    labels, D = pm.sensitivity_rows(c, nm, d, ex["dip_offset_d"] * d, ex["kernel_widths_d"],
+                                    ex["bin_widths_d"], ex["bin_shifts"])
+    depth_hist = D @ history
+    depth_band = es.intervals(D)
+    main = labels.index(f"kernel {ex['kernel_d']:g} d")
+    spread = float(depth_hist.max() - depth_hist.min())
+    geometry, called = pm.dip_verdict(depth_hist[main], spread, *depth_band[main])
+    if log is not None:
+        log.info("%d LPs in %.1f s (%.1f s in HiGHS), total %.1f s", es.n_lp, es.lp_time, es.lp_time,
+                 time.perf_counter() - t0)
+    width = max(len(v) for v in polys)
+    V = _pad(polys, width)
+    ds = xr.Dataset(
+        {
+            "vertex_fx": (("cut", "vertex"), V[..., 0], {"units": "N", "long_name": "exact polygon of the cut resultant: F_x of its vertices (NaN padding)"}),
+            "vertex_fy": (("cut", "vertex"), V[..., 1], {"units": "N", "long_name": "exact polygon of the cut resultant: F_y of its vertices (NaN padding)"}),
+            "n_vertices": ("cut", np.array([len(v) for v in polys]), {"units": "1", "long_name": "vertices of the exact polygon"}),
+            "polygon_area": ("cut", np.array([max(polygon_area(v), 0.0) for v in polys]), {"units": "N2", "long_name": "area of the exact polygon"}),
+            "n_lp": ("cut", np.array(n_lp), {"units": "1", "long_name": "linear programs solved for the polygon"}),
+            "exact": ("cut", np.array(exact, np.int8), {"units": "1", "long_name": "polygon confirmed edge by edge (1) or LP budget exhausted (0)", "flag_values": np.array([0, 1], np.int8), "flag_meanings": "budget_exhausted confirmed"}),
+            "angle_min": ("cut", angle[:, 0], {"units": "degree", "long_name": "smallest angle below the horizontal (outward) of an admissible resultant"}),
+            "angle_max": ("cut", angle[:, 1], {"units": "degree", "long_name": "largest angle below the horizontal (outward) of an admissible resultant"}),
+            "fy_min": ("cut", fy_min, {"units": "N", "long_name": "smallest vertical component of an admissible resultant"}),
+            "fy_max": ("cut", fy_max, {"units": "N", "long_name": "largest vertical component of an admissible resultant (< 0: every state arches)"}),
+            "all_arch": ("cut", (fy_max < 0).astype(np.int8), {"units": "1", "long_name": "every admissible state pushes the bank downward across this cut", "flag_values": np.array([0, 1], np.int8), "flag_meanings": "not_every_state every_state"}),
+            "history_outside": ("cut", hist_out, {"units": "N", "long_name": "distance of the history resultant outside the exact polygon"}),
+            "polygon_wall_time": ("cut", np.array(walls), {"units": "s", "long_name": "measured wall time of the polygon's LPs (a measurement, not reproducible)"}),
+            "bin_min": ("bin", band_bin[:, 0] , {"units": "N m-1", "long_name": "exact minimum of the binned ground pressure over A ∩ C"}),
+            "bin_max": ("bin", band_bin[:, 1], {"units": "N m-1", "long_name": "exact maximum of the binned ground pressure over A ∩ C"}),
+            "kernel_min": ("x_kernel", band_kernel[:, 0], {"units": "N m-1", "long_name": "exact minimum of the kernel ground pressure over A ∩ C"}),
+            "kernel_max": ("x_kernel", band_kernel[:, 1], {"units": "N m-1", "long_name": "exact maximum of the kernel ground pressure over A ∩ C"}),
+            "kernel_history": ("x_kernel", K @ history, {"units": "N m-1", "long_name": "kernel ground pressure of the history forces"}),
+            "choice": ("choice", np.array(labels), {"units": "1", "long_name": "ground-pressure estimate (kernel width, or bin width and shift)"}),
+            "depth_history": ("choice", depth_hist, {"units": "N m-1", "long_name": "dip depth p(0) - (p(-a) + p(a))/2 of the history forces"}),
+            "depth_min": ("choice", depth_band[:, 0], {"units": "N m-1", "long_name": "exact minimum of the dip depth over A ∩ C"}),
+            "depth_max": ("choice", depth_band[:, 1], {"units": "N m-1", "long_name": "exact maximum of the dip depth over A ∩ C"}),
+        },
+        coords={"cut": cuts["cut"].values, "vertex": np.arange(width), "bin": cuts["bin"].values,
+                "x_kernel": xg},
+        attrs=provenance(cfg, weight=weight, n_contacts=c.n, n_grains=nm, mean_diameter=d,
+                         vertex_equilibrium=vertex_check[0], vertex_coulomb=vertex_check[1],
+                         dip_geometry=geometry, dip_called=called, dip_binning_spread=spread,
+                         dip_main_choice=labels[main], dip_offset=ex["dip_offset_d"] * d,
+                         kernel_width=ex["kernel_d"] * d, n_lp_total=es.n_lp),
+    )
+    ds["x_kernel"].attrs.update(units="m", long_name="abscissa of the kernel ground pressure")
+    ds["vertex"].attrs.update(units="1", long_name="vertex index")
+    for k in ("cut", "bin"):
+        ds[k].attrs.update({a: cuts[k].attrs[a] for a in ("units", "long_name") if a in cuts[k].attrs})
+    return ds

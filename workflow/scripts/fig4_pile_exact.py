@@ -1,0 +1,19 @@
+"""Figure 4: the exact set A ∩ C of the final pile by LP -- cut polygons, angle ranges, ground pressure (exact.nc)."""
+import xarray as xr
+
+from ncd.figures import pile_exact
+from ncd.io import write_dataset
+from ncd.pipeline import start
+
+log = start(snakemake)  # noqa: F821 (snakemake is injected)
+ds = pile_exact.exact_dataset(snakemake.params.config, xr.load_dataset(snakemake.input.construction),  # noqa: F821
+                              xr.load_dataset(snakemake.input.cuts), log)  # noqa: F821
+write_dataset(ds, snakemake.output[0])  # noqa: F821
+a = ds.attrs
+m = list(ds.choice.values).index(a["dip_main_choice"])
+log.info("default cut: %d vertices, %d LPs, %.1f s; cuts where every admissible state arches: %d of %d; "
+         "dip (%s): history depth %.4g N/m, binning spread %.3g, exact range [%.4g, %.4g] -> %s, called: %s",
+         int(ds.n_vertices[0]), int(ds.n_lp[0]), float(ds.polygon_wall_time[0]), int(ds.all_arch.sum()),
+         ds.sizes["cut"], a["dip_main_choice"], float(ds.depth_history[m]), a["dip_binning_spread"],
+         float(ds.depth_min[m]), float(ds.depth_max[m]), a["dip_geometry"],
+         a["dip_called"])
