@@ -41,8 +41,7 @@
 # a random review order per run (the same orders for (a) and (b)). The paper's
 # question hides a numerical one: **is the dispersion a true indeterminacy of
 # the step problem, or the iteration error of runs stopped at a finite
-# tolerance**, which lies along the slowest-converging mode and can also look
-# like a line? Every run is therefore *continued from tolerance to tolerance*
+# tolerance**, which can also look like a line? Every run is therefore *continued from tolerance to tolerance*
 # (relative natural-map residual, decades), so that each run gives its
 # acceleration $(u_f - u_i)/h$ at every tolerance: a true indeterminacy keeps a
 # fixed non-zero spread as the tolerance tightens, an iteration error shrinks
@@ -56,12 +55,15 @@ from matplotlib.collections import LineCollection, PatchCollection
 from matplotlib.colors import LogNorm
 from matplotlib.patches import Circle
 
+from IPython.display import Markdown
+
+from ncd.figures import census as cs
 from ncd.figures import slope_analysis as sa
 
 from ncd.notebook import paths, save
 
 # Snakemake's object, or by hand (from the repository or notebooks/) the files under results/
-_smk = paths("fig2_slope", ["trajectory", "ensemble", "measures"], globals().get("snakemake"))
+_smk = paths("fig2_slope", ["trajectory", "ensemble", "measures", "census"], globals().get("snakemake"))
 inp, out, cfg = _smk.input, _smk.output, _smk.params.config
 
 traj = xr.load_dataset(inp.trajectory)
@@ -392,6 +394,22 @@ a.legend(fontsize=7)
 save(fig, out, dpi=150)
 
 # %% [markdown]
+# ## The census of the step's exact solutions
+#
+# NLGS end points say which solutions NLGS reaches, not how many the step has.
+# `census.nc` gathers exact solutions from the NLGS end points (zero-guess,
+# warm-start and random-guess runs), from Lemke's pivoting method on the LCP
+# form of the step (size $3\kappa$, several covering vectors) and from the
+# enumeration of contact-status patterns on the contacts that switch between
+# the solutions found; each is polished on its statuses to a residual of
+# $10^{-12}$, counted by basin (how many runs end on it) and restarted from a
+# $10^{-9}$ perturbation to see whether NLGS returns to it.
+
+# %%
+census = xr.load_dataset(inp.census)
+Markdown(cs.census_text(census))
+
+# %% [markdown]
 # ## What we measured, and where the reproduction differs
 #
 # The numbers printed above are those of this run (the reduced test
@@ -411,19 +429,20 @@ save(fig, out, dpi=150)
 #   no zero-guess run at step 100, one warm run of six at step 50); the flow
 #   itself stopped 4 of its steps at its 20000-sweep budget (tolerance
 #   $10^{-6}$). Such steps were not used.
-# * **The line is made of two points.** The converged runs reach exactly two
-#   distinct solutions (zero guess: 323 and 677 runs; warm start: all 1000 on
-#   the first, which is also the one the time stepping itself followed). Every
-#   grain's cloud is then a segment: minor/major $6\times10^{-6}$ for the
-#   chosen grain, at most $1.2\times10^{-4}$ over the 52 grains (15 %) with a
-#   visible dispersion. We never saw an extended 2-D cloud.
+# * **NLGS reaches two end points; the step has more solutions.** The
+#   converged runs reach two distinct solutions (zero guess: 323 and 677 runs;
+#   warm start: all 1000 on the first, which is also the one the time stepping
+#   itself followed), so every grain's NLGS cloud is a segment: minor/major
+#   $6\times10^{-6}$ for the chosen grain, at most $1.2\times10^{-4}$ over the
+#   52 grains (15 %) with a visible dispersion. These two points are not the
+#   whole solution set: the census below (Lemke's method, status enumeration,
+#   random guesses) counts the exact solutions of the step from this run's data.
 # * **Loose tolerances draw the line too.** At $10^{-3}$ both ensembles are
 #   elongated clouds along nearly the same direction (major axis at $-12°$
 #   and $-9°$ against $-6.6°$ for the segment joining the two solutions;
 #   minor/major 0.13 and 0.27), and most grains show a visible dispersion
 #   (79 % and 69 %), the warm start included (spread 0.46 m/s² against 0.80).
-#   The slowest-converging NLGS mode is nearly the difference of the two
-#   solutions. The paper's contrast — a line from the zero guess, almost
+#   The paper's contrast — a line from the zero guess, almost
 #   nothing from the warm start — appears here from $10^{-4}$ on (1.11 against
 #   0.018 m/s²) and holds at convergence, where the line shrinks to its two
 #   end points.
@@ -438,9 +457,8 @@ save(fig, out, dpi=150)
 #   contact, 0.16 at three to five, 0.03 at twelve to fourteen. This supports
 #   Moreau's hint that the non-sliding contacts are determinant: they are
 #   where the choice is made (stick or slip), and they carry it to the grains
-#   around. The direction of a grain's line is that of the difference of the
-#   two solutions at that grain; its rank is one because there are two
-#   solutions.
+#   around. The direction of a grain's NLGS line is that of the difference of
+#   the two solutions NLGS reaches at that grain.
 # * **Warm starts are not always determinate.** At the default step all
 #   warm-started runs agree, as the paper says. The scan shows that this is
 #   not a rule: at step 90 the warm-started runs reach two solutions while
@@ -454,7 +472,7 @@ save(fig, out, dpi=150)
 #   layer (30 d wide, about 10 d thick), the rough ground, the deposit, the
 #   time step and the investigated time (35 ms after the release, mean
 #   velocity 0.03 m/s, accelerating at 0.86 m/s²) are ours; the paper gives
-#   none of them. Its figure shows a line of many points; at convergence ours
-#   has two, and a filled line only for runs stopped at a loose tolerance, so
+#   none of them. Its figure shows a line of many points; at convergence our
+#   NLGS runs reach two, and a filled line only for runs stopped at a loose tolerance, so
 #   the points *inside* the paper's line may well be runs stopped before
 #   convergence, while the line itself joins distinct solutions.

@@ -238,3 +238,34 @@ def test_a_member_does_not_depend_on_its_shard(data):
     alone = slope.run_ensemble(traj, cfg, [member])
     for v in ("accel_x", "accel_y", "sweeps", "residual", "converged", "impulse_n", "impulse_t", "status"):
         np.testing.assert_array_equal(alone[v].sel(run=member).values, ens[v].sel(run=member).values, err_msg=v)
+
+
+def test_census_solutions_are_exact_and_contain_the_nlgs_end_points(data, results):
+    """Every census solution is polished to a residual <= 1e-12 and satisfies the contact law
+    componentwise; every converged NLGS run of the ensemble ends on one of them; the census
+    recomputes its solutions' accelerations from its impulses."""
+    from ncd.figures import census as cs
+    from ncd.figures.slope import scene_at_step
+    from ncd.stepper import prepare_step
+    traj, ens, meas, cfg, an = data
+    cen = xr.load_dataset(results / "fig2_slope" / "census.nc")
+    ccfg = yaml.safe_load(cen.attrs["config_yaml"])
+    assert cen.sizes["solution"] >= meas.sizes["solution"] >= 1
+    assert cen.residual.max() <= ccfg["polish_tol"] and cen.law_violation.max() <= 1e-10
+    tight = ens.isel(tol=-1)
+    ok = tight.converged.values.astype(bool)
+    assert sum(int(cen[f"n_{i}"].sum()) for i in ens.init.values) == ok.sum()
+    assert cen.by_nlgs.sum() >= meas.sizes["solution"]
+    step = cs.StepSolutions(scene_at_step(traj, {"scene": cfg["scene"], "flow": cfg["flow"]}),
+                            prepare_step(scene_at_step(traj, {"scene": cfg["scene"], "flow": cfg["flow"]}),
+                                         float(traj.attrs["h"])))
+    for k in range(cen.sizes["solution"]):
+        s = np.column_stack([cen.impulse_n.values[k], cen.impulse_t.values[k]])
+        assert step.residual(s) <= ccfg["polish_tol"]
+        a = step.accel(s)
+        assert np.abs(a[:, 0] - cen.accel_x.values[k]).max() <= 1e-9 * step.g
+    for i in range(cen.sizes["solution"]):       # distinct: fields differ by more than same_tol |g|
+        for j in range(i):
+            d = max(np.abs(cen.accel_x.values[i] - cen.accel_x.values[j]).max(),
+                    np.abs(cen.accel_y.values[i] - cen.accel_y.values[j]).max())
+            assert d > ccfg["same_tol"] * step.g

@@ -10,6 +10,7 @@ import yaml
 
 import ncd
 from ncd.contacts import Contacts, h_matrix, match_warm
+from ncd.figures import pile_exact
 from ncd.figures import cuts as cm
 from ncd.figures import pile
 
@@ -135,7 +136,7 @@ def test_warm_memory_survives_pouring(little_pile):
 @pytest.fixture(scope="module")
 def data(results):
     d = results / "fig4_pile"
-    out = {n: xr.load_dataset(d / f"{n}.nc") for n in ("construction", "cuts", "ensemble", "tolerance")}
+    out = {n: xr.load_dataset(d / f"{n}.nc") for n in ("construction", "cuts", "ensemble", "tolerance", "exact")}
     out["cfg"] = yaml.safe_load(out["construction"].attrs["config_yaml"])
     return out
 
@@ -220,9 +221,52 @@ def test_cloud_is_smaller_than_the_cut_sensitivity(data):
     cuts, ens = data["cuts"], data["ensemble"]
     kind = list(cuts.kind.values)
     k, km, kp = kind.index("default"), kind.index("minus"), kind.index("plus")
-    conv = ens.converged.values.astype(bool)
+    conv = pile_exact.rest_mask(ens)
     P = np.column_stack([ens.cut_force_x.values[conv, k], ens.cut_force_y.values[conv, k]])
     diameter = np.max(np.hypot(*(P[:, None] - P[None]).transpose(2, 0, 1)))
     F = np.column_stack([cuts.history_fx.values, cuts.history_fy.values])
     change = min(np.linalg.norm(F[km] - F[k]), np.linalg.norm(F[kp] - F[k]))
     assert diameter < change, f"cloud diameter {diameter:.4g} N, cut change {change:.4g} N"
+
+
+def test_every_run_is_classified(data):
+    """Outcomes: rest, motion or unconverged, counted; a rest run is a solution whose grains
+    are at rest (largest speed <= 1e-8 g h) and whose residual met the finishing tolerance."""
+    ens, cfg = data["ensemble"], data["cfg"]
+    oc = ens.outcome.values
+    assert set(np.unique(oc)) <= {0, 1, 2} and ens.outcome.attrs["flag_meanings"] == "unconverged rest motion"
+    rest = oc == 1
+    assert rest.sum() >= 1
+    assert ens.max_speed.values[rest].max() <= 1e-8
+    assert ens.residual.values[rest].max() <= cfg["ensemble"]["finish_tol"]
+    assert np.all(ens.max_speed.values[oc == 2] > 1e-8)
+
+
+def test_exact_polygons_contain_every_converged_rest_run(data):
+    """Every rest run's resultant lies inside the exact polygon of its cut to 1e-8 of the
+    pile's weight, for every cut; the history resultant too (to the equilibrium test's accuracy)."""
+    ens, ex = data["ensemble"], data["exact"]
+    W = ex.attrs["weight"]
+    rest = pile_exact.rest_mask(ens)
+    assert ex.sizes["cut"] == data["cuts"].sizes["cut"]
+    for k in range(ex.sizes["cut"]):
+        _, out, cov = pile_exact.cloud_in_polygon(ex, ens, k, rest)
+        assert out.max(initial=0.0) <= 1e-8 * W, f"cut {k}: {out.max() / W:.2e} W outside"
+        assert 0.0 <= cov <= 1.0 + 1e-9
+    assert ex.history_outside.max() <= 1e-6 * W
+    assert ex.exact.values.all() and ex.n_lp[0] >= data["cfg"]["exact"]["n_dirs"]
+
+
+def test_lp_vertices_are_admissible_and_the_dip_verdict_follows_the_numbers(data):
+    ex = data["exact"]
+    assert ex.attrs["vertex_equilibrium"] <= 1e-10 and ex.attrs["vertex_coulomb"] <= 1e-10
+    assert np.all(ex.bin_min.values <= ex.bin_max.values + 1e-9)
+    assert np.all(ex.kernel_min.values <= ex.kernel_history.values + 1e-6 * ex.attrs["weight"])
+    assert np.all(ex.kernel_history.values <= ex.kernel_max.values + 1e-6 * ex.attrs["weight"])
+    m = list(ex.choice.values).index(ex.attrs["dip_main_choice"])
+    lo, hi = float(ex.depth_min[m]), float(ex.depth_max[m])
+    assert lo - 1e-6 <= float(ex.depth_history[m]) <= hi + 1e-6
+    geometry = "forced" if hi < 0 else ("excluded" if lo >= 0 else "allowed")
+    assert ex.attrs["dip_geometry"] == geometry
+    # every admissible state arches across a cut exactly when the largest F_y is negative
+    assert np.array_equal(ex.all_arch.values.astype(bool), ex.fy_max.values < 0)

@@ -307,7 +307,7 @@ def census_dataset(traj, ens, measures, cfg, log=None):
                          n_patterns=out["n_patterns"], segment_pair=out["segment_pair"].astype(np.int64),
                          random_guess_scale=out["random_scale"],
                          random_converged=int((out["label_rnd"] != -2).sum()),
-                         lemke_status=";".join(f"{i['status']} ({i['pivots']} pivots)" for i in out["lemke_info"])),
+                         lemke_status="; ".join(f"{i['status']} after {i['pivots']} pivots" for i in out["lemke_info"])),
     )
     for k, (u, ln) in {"solution": ("1", "exact solution index"), "disc": ("1", "grain index"),
                        "contact": ("1", "contact index"), "segment_t": ("1", "position on the segment"),
@@ -318,3 +318,42 @@ def census_dataset(traj, ens, measures, cfg, log=None):
                  n, *(len(out["per_method"][m]) for m in METHODS), out["n_patterns"],
                  {k: round(v, 1) for k, v in out["times"].items()})
     return ds
+
+
+def census_text(ds):
+    """Markdown from census.nc: how many exact solutions each method found, and a table
+    of the solutions (how found, basins, stability, the chosen grain's acceleration)."""
+    a = ds.attrs
+    n = ds.sizes["solution"]
+    g = float(a["g"])
+    head = (f"The census finds **{n} distinct exact solutions** of the step (relative natural-map residual "
+            f"at most {float(ds.residual.max()):.0e}, largest componentwise violation of the contact law "
+            f"{float(ds.law_violation.max()):.0e}): {a['n_nlgs']} among the NLGS end points (zero-guess, "
+            f"warm-start and {a['random_converged']} converged random-guess runs), {a['n_lemke']} by Lemke's "
+            f"method ({a['lemke_status']}), {a['n_enumeration']} by the enumeration of "
+            f"{a['n_patterns']} status patterns. ")
+    seg = ds.segment_residual.values
+    pair = np.atleast_1d(a["segment_pair"])
+    if n >= 2 and np.all(np.isfinite(seg)):
+        head += (f"The straight segment between the two most visited solutions ({pair[0]} and {pair[1]}) holds "
+                 f"no solution: residual {seg.min():.1e} to {seg.max():.1e} at t = "
+                 f"{', '.join(f'{t:g}' for t in ds.segment_t.values)}.")
+    inits = [v for v in ds.data_vars if v.startswith("n_") and v not in ("n_random", "n_switched", "n_grains_differ")]
+    cols = ["solution", "found by"] + [f"{v[2:]} runs" for v in inits] + [
+        "random runs", "returns after 1e-9 noise", "grain accel. (m/s²)", "contacts switched", "grains differ"]
+    lines = ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
+    for k in range(n):
+        by = ", ".join(m for m in METHODS if int(ds[f"by_{m}"][k]))
+        lines.append("| " + " | ".join([str(k), by] + [str(int(ds[v][k])) for v in inits] + [
+            str(int(ds.n_random[k])), f"{int(ds.returns[k])}/{yaml_safe(a, 'perturb_runs', '?')}",
+            f"({float(ds.grain_accel_x[k]):.3f}, {float(ds.grain_accel_y[k]):.3f})", str(int(ds.n_switched[k])),
+            str(int(ds.n_grains_differ[k]))]) + " |")
+    tail = (f"\n\n*grains differ*: acceleration differs from solution 0 by more than "
+            f"{float(yaml_safe(a, 'grain_differ', 0.01)):g} $|g|$ ($|g|$ = {g:.2f} m/s²).")
+    return head + "\n\n" + "\n".join(lines) + tail
+
+
+def yaml_safe(attrs, key, default):
+    """A census config value from the provenance YAML of census.nc."""
+    import yaml
+    return yaml.safe_load(attrs.get("config_yaml", "{}")).get(key, default)

@@ -6,13 +6,18 @@ simulated with warm-started NLGS (the antecedent impulses as initial guess,
 section 2) until the equilibrium test of section 2 passes.  The final
 arrangement is then explored by NLGS runs from the zero guess with random
 review orders (section 5); the measures of :mod:`ncd.figures.cuts` (cut
-resultants, ground pressure) are kept per run.
+resultants, ground pressure) are kept per run, with the run's outcome
+(:func:`ncd.convergence.classify`: converged at rest, converged in motion, or not;
+the observable is the default cut resultant and the binned ground pressure).
 """
+import time
+
 import numpy as np
+import scipy.sparse as sp
 import xarray as xr
 
 import ncd
-from ncd.explore import explore, member_rng
+from ncd.explore import member_rng
 from ncd.io import provenance
 from ncd.model import SimulationError
 from ncd.pipeline import settings as solver_settings
@@ -195,6 +200,45 @@ def cuts_dataset(cfg, construction):
     return out
 
 
+def _observable(cfg, scene, contacts, C, edges):
+    """``observe(impulse, vel, spin)``: the default cut resultant and the binned ground
+    pressure times the bin width, over the pile's weight (order one)."""
+    nm = scene.n_mobile
+    weight = float(np.sum(scene.mass[:nm]) * cfg["gravity"])
+    rows = cm.ground_matrix(contacts, nm, edges)[2:]
+    M = sp.vstack([C[:2], rows]).tocsr() / (cfg["h"] * weight)
+
+    def observe(impulse, vel, spin):
+        return M @ np.asarray(impulse).ravel()
+    return observe
+
+
+def _classified_runs(scene, problem, members, root_seed, settings, observe, h, progress=None):
+    """Zero-guess runs with the random review order of each member (as
+    :func:`ncd.explore.explore`), observed and classified (:mod:`ncd.convergence`)."""
+    from ncd.convergence import classify, max_speed
+    from ncd.explore import run_parallel
+    n, nm, nr = problem.contacts.n, scene.n_mobile, len(members)
+    out = {"impulse": np.zeros((nr, n, 2)), "vel": np.zeros((nr, nm, 2)), "spin": np.zeros((nr, nm)),
+           **{k: np.zeros(nr) for k in ("sweeps", "residual", "change", "converged", "wall_time", "outcome",
+                                        "max_speed", "observable_change", "finish_rounds")}}
+
+    def run(k):
+        order = member_rng(members[k], root_seed).permutation(n)
+        t0 = time.perf_counter()
+        result, vel, spin = ncd.solve_problem(scene, problem, None, order, settings, observe=observe)
+        out["wall_time"][k] = time.perf_counter() - t0
+        out["impulse"][k], out["vel"][k], out["spin"][k] = result.impulse, vel[:nm], spin[:nm]
+        for key in ("sweeps", "residual", "change", "converged", "observable_change", "finish_rounds"):
+            out[key][k] = getattr(result, key)
+        out["outcome"][k] = classify(result, vel, spin, scene, h)
+        out["max_speed"][k] = max_speed(vel, spin, scene, h)
+
+    run_parallel(run, nr, progress=progress)
+    out["converged"] = out["converged"].astype(bool)
+    return out
+
+
 def ensemble_shard(cfg, construction, cuts, members, tolerances, root_seed, log=None):
     """NLGS runs from the zero guess with random review orders on the final state
     (section 5), one set per tolerance; per run the cut resultants, the ground force
@@ -214,12 +258,15 @@ def ensemble_shard(cfg, construction, cuts, members, tolerances, root_seed, log=
         ("cut_force_x", (cuts.sizes["cut"],)), ("cut_force_y", (cuts.sizes["cut"],)),
         ("ground_pressure", (cuts.sizes["bin"],)), ("ground_fx", ()), ("ground_fy", ()),
         ("unbalanced_fy", ()), ("max_velocity", ()), ("n_moving", ()), ("sweeps", ()), ("residual", ()),
-        ("change", ()), ("converged", ()), ("wall_time", ()))}
+        ("change", ()), ("converged", ()), ("wall_time", ()), ("outcome", ()), ("max_speed", ()),
+        ("observable_change", ()), ("finish_rounds", ()))}
+    observe = _observable(cfg, scene, c, C, edges)
     for j, tol in enumerate(tolerances):
-        settings = ncd.SolverSettings(tol=float(tol), max_sweeps=e["max_sweeps"], check_every=e["check_every"])
+        settings = ncd.SolverSettings(tol=float(tol), max_sweeps=e["max_sweeps"], check_every=e["check_every"],
+                                      finish=e.get("finish", "none"), finish_tol=e.get("finish_tol", 1e-10),
+                                      observable_tol=e.get("observable_tol", 1e-6))
         prog = Progress(log, len(members), f"tol {tol:g}") if log is not None else None
-        out = explore(scene, problem, members, root_seed, init="zero", review="random", settings=settings,
-                      progress=prog)
+        out = _classified_runs(scene, problem, members, root_seed, settings, observe, h, prog)
         s = out["impulse"].reshape(len(members), -1)
         F = (C @ s.T).T / h
         res["cut_force_x"][:, j], res["cut_force_y"][:, j] = F[:, 0::2], F[:, 1::2]
@@ -231,7 +278,8 @@ def ensemble_shard(cfg, construction, cuts, members, tolerances, root_seed, log=
         res["max_velocity"][:, j] = speed.max(axis=1)
         res["n_moving"][:, j] = (speed > e["moving_tol"]).sum(axis=1)
         res["unbalanced_fy"][:, j] = out["vel"][..., 1] @ scene.mass[:nm] / h
-        for k in ("sweeps", "residual", "change", "converged", "wall_time"):
+        for k in ("sweeps", "residual", "change", "converged", "wall_time", "outcome", "max_speed",
+                  "observable_change", "finish_rounds"):
             res[k][:, j] = out[k]
         if log is not None:
             log.info("tol %g: %d runs, %d converged, sweeps %d..%d, mean %.3f s/run", tol, len(members),
@@ -239,7 +287,8 @@ def ensemble_shard(cfg, construction, cuts, members, tolerances, root_seed, log=
     data = {}
     for k, v in res.items():
         tail = () if v.ndim == 2 else ("cut",) if k.startswith("cut") else ("bin",)
-        v = v.astype(bool) if k == "converged" else v.astype(np.int64) if k in ("sweeps", "n_moving") else v
+        v = v.astype(bool) if k == "converged" else v.astype(np.int64) if k in ("sweeps", "n_moving", "finish_rounds") \
+            else v.astype(np.int8) if k == "outcome" else v
         data[k] = (("run", "tol") + tail, v)
     ds = xr.Dataset(data, coords={"run": members, "tol": np.asarray(tolerances, float),
                                   "cut": cuts["cut"].values, "bin": cuts["bin"].values},
@@ -247,6 +296,12 @@ def ensemble_shard(cfg, construction, cuts, members, tolerances, root_seed, log=
                                      max_sweeps=e["max_sweeps"], check_every=e["check_every"],
                                      moving_tol=e["moving_tol"], init="zero", review="random"))
     ds["max_velocity"].attrs["units"] = "g h (largest |u_f| or |r w_f| over grains; 0 at equilibrium)"
+    from ncd.convergence import MAX_SPEED_ATTRS, outcome_attrs
+    ds["outcome"].attrs.update(outcome_attrs())
+    ds["max_speed"].attrs.update(MAX_SPEED_ATTRS)
+    ds["observable_change"].attrs.update(units="1", long_name="largest relative change of the observable (default "
+                                         "cut resultant and kernel ground pressure, over the weight) over the last checks")
+    ds["finish_rounds"].attrs.update(units="1", long_name="active-set rounds of the finishing stage")
     ds["unbalanced_fy"].attrs["note"] = "sum of m u_f,y / h: ground_fy - weight equals it exactly"
     ds["wall_time"].attrs["note"] = ("measured seconds per run, while the rule's other threads ran other members "
                                      "(the only non-reproducible variable)")

@@ -277,3 +277,75 @@ def exact_dataset(cfg, construction, cuts, log=None):
     for k in ("cut", "bin"):
         ds[k].attrs.update({a: cuts[k].attrs[a] for a in ("units", "long_name") if a in cuts[k].attrs})
     return ds
+
+
+# ---------------------------------------------------------------- reading exact.nc with an ensemble
+def polygon_of(exact, k):
+    """Vertices (ccw) of the exact polygon of cut ``k``."""
+    v = np.column_stack([exact.vertex_fx.values[k], exact.vertex_fy.values[k]])
+    return v[np.isfinite(v[:, 0])]
+
+
+def rest_mask(ens):
+    """Runs converged at rest (outcome 1), the only ones drawn in a cloud."""
+    from ..convergence import REST
+    return ens["outcome"].values == REST
+
+
+def cloud_in_polygon(exact, ens, k, mask):
+    """Points of cut ``k`` of the runs in ``mask``, their distance outside the exact
+    polygon (N) and the coverage (cloud hull area / polygon area)."""
+    from ..polytope import hull_area, outside_distance
+    P = np.column_stack([ens.cut_force_x.values[mask, k], ens.cut_force_y.values[mask, k]])
+    poly = polygon_of(exact, k)
+    out = outside_distance(P, poly) if len(P) else np.zeros(0)
+    area = float(exact.polygon_area.values[k])
+    return P, out, (hull_area(P) / area if area > 0 and len(P) >= 3 else 0.0)
+
+
+def draw_cloud(ax, exact, ens, k, mask, color="C0", label=None):
+    """The exact polygon of cut ``k`` (shaded) and the converged rest runs (dots)."""
+    poly = polygon_of(exact, k)
+    ax.fill(*np.vstack([poly, poly[:1]]).T, color="0.85", lw=0.8, ec="0.4", label="exact projection of A ∩ C")
+    P, _, _ = cloud_in_polygon(exact, ens, k, mask)
+    ax.plot(P[:, 0], P[:, 1], ".", ms=2, color=color, label=label)
+    ax.set(xlabel="$F_x$ (N)", ylabel="$F_y$ (N)")
+    ax.set_aspect("equal", adjustable="datalim")
+
+
+def exact_text(exact, ens, cuts):
+    """Markdown from exact.nc and the ensemble: outcomes, polygons and coverage of the
+    default and shifted cuts, arching over all cuts, the ground-pressure dip verdict."""
+    from ..convergence import OUTCOMES
+    a, W = exact.attrs, float(exact.attrs["weight"])
+    oc = ens["outcome"].values
+    counts = {OUTCOMES[k]: int((oc == k).sum()) for k in sorted(OUTCOMES)}
+    mask = oc == 1
+    lines = [f"Of the {len(oc)} zero-guess runs, {counts['rest']} converged at rest, {counts['motion']} converged "
+             f"on a motion solution (grains moving faster than the rest bound) and {counts['unconverged']} did "
+             f"not converge; only the {counts['rest']} rest states are drawn."]
+    for k, name in ((0, "default"), (1, "moved by -1 d"), (2, "moved by +1 d")):
+        P, out, cov = cloud_in_polygon(exact, ens, k, mask)
+        lines.append(f"Cut {name}: exact polygon of {int(exact.n_vertices[k])} vertices ({int(exact.n_lp[k])} LPs), "
+                     f"diameter {_diameter(polygon_of(exact, k)):.4f} N; the rest runs cover "
+                     f"{100 * cov:.2g} % of its area and lie inside it to "
+                     f"{(out.max() if len(out) else 0.0) / W:.1e} of the weight.")
+    arch = exact.all_arch.values.astype(bool)
+    lines.append(f"Every admissible force state arches (pushes the bank downward) across {arch.sum()} of the "
+                 f"{len(arch)} cuts; the exact angle of the resultant below the horizontal spans "
+                 f"{np.nanmin(exact.angle_max.values - exact.angle_min.values):.1f}° to "
+                 f"{np.nanmax(exact.angle_max.values - exact.angle_min.values):.1f}° (median "
+                 f"{np.nanmedian(exact.angle_max.values - exact.angle_min.values):.1f}°) across a cut.")
+    m = list(exact.choice.values).index(a["dip_main_choice"])
+    lines.append(f"Ground pressure ({a['dip_main_choice']} kernel): dip depth p(0) - (p(-a)+p(a))/2 with "
+                 f"a = {a['dip_offset'] * 1e3:.1f} mm is {float(exact.depth_history[m]):.1f} N/m for the history "
+                 f"forces; over the analysis choices it spans {a['dip_binning_spread']:.1f} N/m; over A ∩ C it "
+                 f"ranges exactly from {float(exact.depth_min[m]):.1f} to {float(exact.depth_max[m]):.1f} N/m: a dip "
+                 f"is **{a['dip_geometry']}** by the geometry, and "
+                 f"{'a dip is called' if a['dip_called'] else 'no dip is called'}.")
+    return "\n\n".join(lines)
+
+
+def _diameter(v):
+    v = np.asarray(v).reshape(-1, 2)
+    return float(np.hypot(*(v[:, None] - v[None]).transpose(2, 0, 1)).max()) if len(v) else 0.0

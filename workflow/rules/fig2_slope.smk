@@ -115,6 +115,7 @@ rule fig2_slope_notebook:
         trajectory=f"{F2}/trajectory.nc",
         ensemble=f"{F2}/ensemble.nc",
         measures=f"{F2}/measures.nc",
+        census=f"{F2}/census.nc",
         notebook=notebook_file(FIG2),
         notebook_py=notebook_file(FIG2, "py"),
     output:

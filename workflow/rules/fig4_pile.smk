@@ -121,6 +121,7 @@ rule fig4_pile_notebook:
         cuts=f"{F4}/cuts.nc",
         ensemble=f"{F4}/ensemble.nc",
         tolerance=f"{F4}/tolerance.nc",
+        exact=f"{F4}/exact.nc",
         notebook=notebook_file(FIG4),
         notebook_py=notebook_file(FIG4, "py"),
     output:
