@@ -214,6 +214,9 @@ def exact_shard(packings, cfg, progress=None):
         pad["max_n"][j, :k], pad["max_t"][j, :k] = r["force_max"][:, 0], r["force_max"][:, 1]
         pad["fixed"][j, :k] = r["fixed"]
     scal = {q: np.array([r[q] for r in rows]) for q in SCALARS}
+    scal["bounded"] = scal["bounded"].astype(np.int8)
+    for q in pad:                       # an infinite range (unbounded A ∩ C) is stored as NaN
+        pad[q][~np.isfinite(pad[q])] = np.nan
     nm = packings.sizes["disc"]
     data = {q: _var("packing", scal[q], "1" if q != "scale" else "N", lname) for q, lname in SCALARS.items()}
     data["coordination"] = _var("packing", 2.0 * scal["n_contacts"] / nm, "1",
@@ -236,7 +239,8 @@ SCALARS = {"n_contacts": "contacts kappa", "rank_H": "rank of the equilibrium eq
            "dim_AC_lp": "dim (A ∩ C), affine rank of LP points", "n_fixed": "contacts fixed by statics",
            "eta_exact": "exact indeterminacy ratio (box diagonal / box-centre force)",
            "eta_normal": "exact ratio of normal-force widths to mean normal force",
-           "n_lp": "linear programs solved", "scale": "largest external force |F|"}
+           "n_lp": "linear programs solved", "scale": "largest external force |F|",
+           "bounded": "1: A ∩ C bounded (no self-stress inside C)"}
 
 
 def _no_shards(cfg):
@@ -248,10 +252,12 @@ def unger_relax(scene, problem, cfg, rng, start=None):
     ``noise * <|r|>`` to every contact force component and relax it again by NLGS
     (random review order); ``rounds`` times, a random walk inside the solution set.
     The starting solution is relaxed from ``start`` (the last build step's impulses).
+    NLGS is finished by the active-set stage (``unger.solver.finish``), so that a
+    relaxed point satisfies ``u_f = 0`` to round-off rather than to the tolerance.
     Returns ``(forces (rounds + 1, kappa, 2), converged, at_rest)``: a round counts
     only when NLGS converged and ``u_f = 0`` (the relaxed forces lie in A ∩ C)."""
     u, p = cfg["unger"], cfg["packings"]
-    settings = SolverSettings(**p["rest_solver"])
+    settings = SolverSettings(**u["solver"])
     h, g, nm = p["h"], p["gravity"], scene.n_mobile
     n = problem.contacts.n
     forces, conv, rest = [], [], []
@@ -304,7 +310,7 @@ def unger_shard(packings, cfg, progress=None):
          "relaxed_ok": _var(("packing", "sample"), ok, "1", "1: NLGS converged and u_f = 0 (a point of A ∩ C)"),
          "eta_unger": _var("packing", eta, "1", "Unger et al.'s eta: <|F_k - F_0|> / <|F_0|>")},
         coords=_coords(packing=packings.packing.values, sample=np.arange(m), contact=np.arange(kmax)),
-        attrs=provenance(_no_shards(cfg), SolverSettings(**cfg["packings"]["rest_solver"])))
+        attrs=provenance(_no_shards(cfg), SolverSettings(**cfg["unger"]["solver"])))
 
 
 def merge(pack_paths, exact_paths, unger_paths):

@@ -17,6 +17,9 @@ scaled as in :class:`ncd.polytope.ForcePolytope`):
   direction is either spanned or found flat (:func:`lp_dimension`); it equals
   the rank count when both are right, which the tests check on every packing;
 * contacts fixed by statics (both ranges of width ``<= width_tol * scale``);
+* boundedness: a self-stress inside ``C`` (e.g. an arch wedged between the box walls
+  at large friction) makes ``A ∩ C`` unbounded; its infinite ranges are ``±inf``
+  (NaN in the files) and ``eta_exact`` is NaN (the packing is reported, not averaged);
 * the exact indeterminacy ratio (defined here)
   ``eta_exact = sum_alpha |(Δr_n, Δr_t)|_alpha / sum_alpha |r̄_alpha|``,
   ``Δ`` the widths of the ranges and ``r̄`` the centre of the range box, i.e. the
@@ -69,7 +72,9 @@ class _Model:
         self.n_lp = 0
 
     def minimize(self, c):
-        """``argmin c . x`` (scaled), or None if infeasible; raises on any other failure."""
+        """``argmin c . x`` (scaled), or None if infeasible.  When ``c . x`` is unbounded
+        below, returns ``(x + t d, False)`` style point via :meth:`ray_point` and marks
+        ``self.unbounded``; raises on any other failure."""
         c = np.asarray(c, float)
         changed = np.nonzero(c != self.cost)[0]
         if len(changed):
@@ -78,11 +83,24 @@ class _Model:
         self.h.run()
         self.n_lp += 1
         status = self.h.getModelStatus()
+        self.unbounded = status == highspy.HighsModelStatus.kUnbounded
         if status == highspy.HighsModelStatus.kInfeasible:
             return None
+        if self.unbounded:
+            return self.ray_point(c)
         if status != highspy.HighsModelStatus.kOptimal:
             raise PolytopeError(f"LP failed: {self.h.modelStatusToString(status)}")
         return np.array(self.h.getSolution().col_value)
+
+
+    def ray_point(self, c):
+        """A point of ``A ∩ C`` far along an unbounded ray of decreasing ``c . x``
+        (base point + unit ray): the set is unbounded along ``c``."""
+        _, has_ray, ray = self.h.getPrimalRay()
+        ray = np.asarray(ray, float)
+        if not has_ray or not (c @ ray < 0):
+            raise PolytopeError("HiGHS reported an unbounded LP without a primal ray")
+        return self.base + ray / np.abs(ray).max()
 
 
 def force_ranges(P, model):
@@ -102,10 +120,11 @@ def force_ranges(P, model):
                 if x is None:
                     raise PolytopeError("A ∩ C is empty")
                 points.append(x)
+                value = -sign * np.inf if model.unbounded else x[j]
                 if sign > 0:
-                    lo[a, comp] = x[j]
+                    lo[a, comp] = value
                 else:
-                    hi[a, comp] = x[j]
+                    hi[a, comp] = value
     return lo, hi, np.array(points)
 
 
@@ -120,7 +139,7 @@ def implicit_rows(P, model, points, tol):
     for i in candidate:
         x = model.minimize(G[i])               # maximize the slack -G_i x
         extra.append(x)
-        implicit[i] = -(G[i] @ x) <= tol
+        implicit[i] = not model.unbounded and -(G[i] @ x) <= tol
     return implicit, (np.array(extra) if extra else np.zeros((0, P.G.shape[1])))
 
 
@@ -151,8 +170,10 @@ def lp_dimension(model, points, basis, tol, max_rounds=200):
             return r, flat
         v = vt[r + flat] if r + flat < vt.shape[0] else vt[-1]
         u = basis @ v
-        x1, x2 = model.minimize(u), model.minimize(-u)
-        if abs(u @ (x2 - x1)) <= tol:
+        x1 = model.minimize(u)
+        ub = model.unbounded
+        x2 = model.minimize(-u)
+        if not (ub or model.unbounded) and abs(u @ (x2 - x1)) <= tol:
             flat += 1
         pts += [x1, x2]
     return r, flat
@@ -167,11 +188,10 @@ def exact_measures(H, F, mu, width_tol=1e-7, slack_tol=1e-9):
     model = _Model(P)
     out = {"n_contacts": k, "rank_H": rank_h, "dim_A": 2 * k - rank_h, "n_equations": Hd.shape[0],
            "scale": P.scale}
-    if model.minimize(np.zeros(2 * k)) is None:
+    model.base = model.minimize(np.zeros(2 * k))
+    if model.base is None:
         raise PolytopeError("A ∩ C is empty: the packing is not in equilibrium")
-    out["bounded"] = P.is_bounded()
-    if not out["bounded"]:
-        raise PolytopeError("A ∩ C is unbounded (a self-stress inside C)")
+    out["bounded"] = P.is_bounded()       # False: a self-stress inside C, some ranges infinite
     lo, hi, points = force_ranges(P, model)
     implicit, extra = implicit_rows(P, model, points, slack_tol)
     E = np.vstack([Hd, P.G.toarray()[implicit]])
@@ -182,13 +202,16 @@ def exact_measures(H, F, mu, width_tol=1e-7, slack_tol=1e-9):
     out["dim_AC_lp"], out["flat_directions"] = lp_dimension(model, np.vstack([points, extra]), basis,
                                                             tol=width_tol)
     width = hi - lo
-    mid = 0.5 * (hi + lo)
+    with np.errstate(invalid="ignore"):
+        mid = 0.5 * (hi + lo)
     fixed = (width <= width_tol).all(axis=1)
+    finite = out["bounded"]
     out.update(
         force_min=lo * P.scale, force_max=hi * P.scale, fixed=fixed, n_fixed=int(fixed.sum()),
         implicit_zero=implicit[2 * k:], implicit_sliding=implicit[:k] | implicit[k:2 * k],
-        eta_exact=float(np.hypot(width[:, 0], width[:, 1]).sum() / np.hypot(mid[:, 0], mid[:, 1]).sum()),
-        eta_normal=float(width[:, 0].sum() / np.abs(mid[:, 0]).sum()),
+        eta_exact=float(np.hypot(width[:, 0], width[:, 1]).sum() / np.hypot(mid[:, 0], mid[:, 1]).sum())
+        if finite else np.nan,
+        eta_normal=float(width[:, 0].sum() / np.abs(mid[:, 0]).sum()) if finite else np.nan,
         n_lp=model.n_lp + P.n_lp)
     return out
 
