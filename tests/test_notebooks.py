@@ -23,3 +23,34 @@ def test_pair_in_sync(py):
     # Snakemake's notebook directive needs the language in the metadata
     assert b.metadata.get("language_info", {}).get("name") == "python"
     assert "ipynb" in b.metadata.get("jupytext", {}).get("formats", "")
+
+
+def test_unsynced_pair_is_noticed(tmp_path):
+    """A .py edited without `jupytext --sync` stops the notebook with the command to run."""
+    from ncd.notebook import NotebookError, check_pair
+
+    src = NOTEBOOKS[0]
+    for f in ("Snakefile", "config.yaml"):
+        (tmp_path / f).write_text("")
+    (tmp_path / "notebooks").mkdir()
+    for ext in (".py", ".ipynb"):
+        (tmp_path / "notebooks" / f"x{ext}").write_bytes(src.with_suffix(ext).read_bytes())
+    check_pair("x", tmp_path)
+    py = tmp_path / "notebooks" / "x.py"
+    py.write_text(py.read_text() + "\n# %%\nprint('edited')\n")
+    with pytest.raises(NotebookError, match="jupytext --sync notebooks/x.py"):
+        check_pair("x", tmp_path)
+
+
+def test_paths_by_hand_from_root_and_from_notebooks(monkeypatch):
+    """By hand, a notebook finds the repository from the root or from notebooks/ and
+    writes only under results/."""
+    from ncd.notebook import paths
+
+    root = NOTEBOOKS[0].parent.parent
+    for cwd in (root, root / "notebooks"):
+        monkeypatch.chdir(cwd)
+        p = paths("stability", ["table"])
+        assert p.input.table == str(root / "results" / "stability" / "table.nc")
+        assert p.output.png == str(root / "results" / "figures" / "stability.png")
+        assert isinstance(p.params.config, dict) and p.params.config
