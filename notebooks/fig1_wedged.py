@@ -165,13 +165,17 @@ wed = conv & (outcome == 1)
 Fn, Ft = ens.force_n.values[wed], ens.force_t.values[wed]
 Iy = ens.I_y.values[wed]
 N = Fn.mean(axis=1)
-eq = np.abs((Fn[:, :, None] * wedge.normals + Ft[:, :, None] * wedge.tangents).sum(1) + [0, -mg]).max() / mg
-print(f"wedged runs: N from {N.min() / mg:.4f} to {N.max() / mg:.1f} mg; largest force-balance defect "
-      f"{eq:.1e} mg; largest |T|/(mu N) = {np.abs(Ft / Fn).max() / wedge.mu:.6f}; "
-      f"largest |I_x| = {np.nanmax(np.abs(ens.I_x.values[wed])) / R:.1e} R")
-print(f"I_y from {Iy.min() / R:.4f} R to {Iy.max() / R:.4f} R: the dots span "
-      f"{100 * (Iy.max() - Iy.min()) / (y_top - y_bot):.1f} % of the closed-form segment; "
-      f"largest distance to y_I(N): {np.abs(Iy - wedge.y_of_n(N)).max() / R:.1e} R")
+if not wed.any():  # e.g. a solver budget too small for any run to converge
+    print(f"no converged wedged run ({int(conv.sum())} of {len(conv)} runs converged): "
+          "nothing to compare with the closed-form segment")
+else:
+    eq = np.abs((Fn[:, :, None] * wedge.normals + Ft[:, :, None] * wedge.tangents).sum(1) + [0, -mg]).max() / mg
+    print(f"wedged runs: N from {N.min() / mg:.4f} to {N.max() / mg:.1f} mg; largest force-balance defect "
+          f"{eq:.1e} mg; largest |T|/(mu N) = {np.abs(Ft / Fn).max() / wedge.mu:.6f}; "
+          f"largest |I_x| = {np.nanmax(np.abs(ens.I_x.values[wed])) / R:.1e} R")
+    print(f"I_y from {Iy.min() / R:.4f} R to {Iy.max() / R:.4f} R: the dots span "
+          f"{100 * (Iy.max() - Iy.min()) / (y_top - y_bot):.1f} % of the closed-form segment; "
+          f"largest distance to y_I(N): {np.abs(Iy - wedge.y_of_n(N)).max() / R:.1e} R")
 
 # %% [markdown]
 # ## The two evolutions
@@ -270,8 +274,8 @@ ax.text(Ns[-1] / mg, y_bot / R, "$R\\sin\\beta$ (limit)", fontsize=8, va="top", 
 ax.set_ylim(y_bot / R - 0.03, y_top / R + 0.02)
 ax.set_xlabel("normal force $N / mg$ (both contacts)")
 ax.set_ylabel("height of $I$, $y_I / R$")
-ax.set_title(f"(c) $I$ against the wedging intensity\ndots span "
-             f"{100 * (Iy.max() - Iy.min()) / (y_top - y_bot):.1f} % of the segment", fontsize=10)
+ax.set_title("(c) $I$ against the wedging intensity\n" + (f"dots span {100 * (Iy.max() - Iy.min()) / (y_top - y_bot):.1f} % "
+             "of the segment" if len(Iy) else "no converged wedged run"), fontsize=10)
 ax.legend(fontsize=8, loc="center right")
 
 ax = fig.add_subplot(gs[0])
@@ -360,7 +364,7 @@ display(Image(data=buf.getvalue()))
 wt = ens.wall_time.values
 print(f"wall time per run: median {np.median(wt) * 1e6:.0f} us, max {wt.max() * 1e3:.2f} ms; "
       f"sweeps: median {np.median(ens.sweeps.values):.0f}, max {ens.sweeps.values.max()}; "
-      f"residual: max over converged runs {ens.residual.values[conv].max():.1e}")
+      f"residual: max over converged runs {ens.residual.values[conv].max() if conv.any() else float('nan'):.1e}")
 
 # %% [markdown]
 # ## What we measured, and where the reproduction differs
