@@ -80,6 +80,8 @@ def test_small_pile_polygons_match_forcepolytope_and_vertices_are_admissible():
         assert abs(mine["outer_area"] - mine["inner_area"]) <= 1e-6 * es.scale ** 2
         eq, co = fp.violations(mine["points"])
         assert eq.max() <= 1e-10 and co.max() <= 1e-10
+        eq, co = fp.violations(np.array([es.refine(r) for r in mine["points"][:4]]))
+        assert eq.max() <= 1e-13 and co.max() <= 1e-13
 
 
 def test_resultant_angle_of_a_polygon():
