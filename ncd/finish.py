@@ -99,7 +99,8 @@ def min_norm_solve(K, r, eps_rel=1e-10):
         return np.zeros(0)
     eps = eps_rel * max(abs(K).sum(axis=1).max(), 1e-300) ** 2
     A = sp.bmat([[sp.identity(m), K.T], [K, -eps * sp.identity(m)]], format="csc")
-    lu = spla.splu(A, permc_spec="COLAMD")
+    lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                  options={"SymmetricMode": True})
     d = np.zeros(m)
     rnorm = np.linalg.norm(r)
     for _ in range(REFINE):
@@ -157,9 +158,10 @@ def polish(W, q, mu, rho, scale, s0, status0, tol, more_sweeps=None, max_sweeps=
         chunk *= 2
 
 
-def check_solution(impulse, U, mu, tol=1e-8):
+def check_solution(impulse, U, mu, tol=1e-8, velocity_scale=None):
     """Componentwise check of the Signorini-Coulomb law; returns a dict of the largest
-    violations (impulses over ``max |s|``, velocities over ``max |U|`` or 1) and ``ok``.
+    violations (impulses over ``max |s|``, velocities over ``velocity_scale``, default
+    ``max |U|``; pass the free-velocity scale, e.g. ``|g| h``, at rest) and ``ok``.
 
     cone: ``s_n >= 0``, ``|s_t| <= mu s_n``; normal complementarity ``U_n >= 0``,
     ``s_n U_n = 0``; sticking contacts (``|s_t| < mu s_n``): ``U_t = 0``; sliding
@@ -167,7 +169,8 @@ def check_solution(impulse, U, mu, tol=1e-8):
     s = np.asarray(impulse, float).reshape(-1, 2)
     U = np.asarray(U, float).reshape(-1, 2)
     S = max(float(np.abs(s).max(initial=0.0)), 1e-300)
-    V = max(float(np.abs(U).max(initial=0.0)), 1.0 if not np.any(U) else 1e-300)
+    V = float(np.abs(U).max(initial=0.0)) if velocity_scale is None else float(velocity_scale)
+    V = V if V > 0 else 1.0
     sn, st = s[:, 0] / S, s[:, 1] / S
     un, ut = U[:, 0] / V, U[:, 1] / V
     inner = np.abs(st) < mu * sn - tol
