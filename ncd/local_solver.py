@@ -97,4 +97,7 @@ def solve_single_contact_py(W, q, mu):
 
 def project_cone_py(zn, zt, mu):
     """:func:`project_cone` with its arguments checked: the public ``ncd.project_cone``."""
-    return project_cone(checks.real("zn", zn), checks.real("zt", zt), checks.real("mu", mu, 0.0))
+    pn, pt = project_cone(checks.real("zn", zn), checks.real("zt", zt), checks.real("mu", mu, 0.0))
+    if not (np.isfinite(pn) and np.isfinite(pt)):
+        raise checks.SimulationError(f"project_cone({zn!r}, {zt!r}, {mu!r}) overflows double precision")
+    return pn, pt

@@ -26,6 +26,7 @@ from dataclasses import dataclass, asdict
 import numpy as np
 import scipy.sparse as sp
 
+from . import checks
 from ._cache import njit
 from .contacts import delassus_blocks, local_velocity
 from .local_solver import natural_map_sq, solve_single_contact
@@ -55,6 +56,7 @@ class SolverSettings:
     keep_best: bool = True
 
     def __post_init__(self):
+        checks.solver_settings(self)    # InputError naming the field (issue 14)
         if not (np.isfinite(self.tol) and self.tol > 0):
             raise ValueError(f"tol = {self.tol!r} must be > 0")
         if self.max_sweeps < 1 or self.check_every < 1:
@@ -311,6 +313,7 @@ def _restitution_bias(e_n, e_t, U_initial):
     return bias
 
 
+@checks.finite_output
 def solve_discs(scene, contacts, vel, spin, guess=None, review_order=None,
                 settings=SolverSettings(), bias=None, W=None, observe=None):
     """Solve the core problem of one step by NLGS in disc form.
@@ -321,6 +324,8 @@ def solve_discs(scene, contacts, vel, spin, guess=None, review_order=None,
     contacts (identity if None); ``bias`` the restitution term ``e U_i``;
     ``observe(impulse, vel, spin)``: see :func:`ncd.convergence.run_nlgs`.
     """
+    guess, review_order, bias, W = checks.disc_problem(scene, contacts, vel, spin, guess, review_order,
+                                                       settings, bias, W)
     n = contacts.n
     impulse = np.zeros((n, 2)) if guess is None else np.array(guess, dtype=float).reshape(n, 2)
     status = np.zeros(n, np.int8)
@@ -407,13 +412,17 @@ def _iterate_local(data, order, status, scale, tol, max_sweeps, criterion, check
     return max_sweeps, res, change, False
 
 
+@checks.finite_output
 def solve_local(W, q, mu, guess=None, review_order=None, settings=SolverSettings()):
     """NLGS on a 2-D frictional contact problem in local form.
 
     Find ``s`` (n, 2) with ``U = W s + q`` and the Coulomb law at each contact.
     ``W`` is (2n, 2n), dense or scipy.sparse, rows ordered (n_1, t_1, n_2, ...);
-    ``q`` (2n,); ``mu`` scalar or (n,).
+    ``q`` (2n,); ``mu`` scalar or (n,).  Checks: :func:`ncd.checks.local_problem`.
     """
+    W, q, mu, guess, review_order = checks.local_problem(W, q, mu, guess, review_order, settings)
+    if len(q) == 0:
+        return NLGSResult(np.zeros((0, 2)), np.zeros(0, np.int8), 0, 0.0, 0.0, True)
     Wc = sp.csr_matrix(W, dtype=float)
     q = np.asarray(q, dtype=float).ravel()
     n = len(q) // 2

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import checks
 from ._cache import njit
 from .contacts import delassus_blocks, detect_contacts, local_velocity, match_warm
 from .model import InputError, SimulationError
@@ -73,8 +74,11 @@ def _check_h_theta(h, theta):
         raise InputError(f"theta = {theta!r} must be in (0, 1]")
 
 
+@checks.finite_problem
 def prepare_step(scene, h, theta=0.5, gap_tolerance=None, vel=None, spin=None):
     """Build the core problem of the step from the current state (or ``vel, spin``)."""
+    checks.scene(scene)
+    h, theta = checks.step_args(h, theta, gap_tolerance, vel, spin, scene.n_disc)
     _check_h_theta(h, theta)
     vel = scene.vel if vel is None else vel
     spin = scene.spin if spin is None else spin
@@ -104,6 +108,7 @@ def solve_problem(scene, problem, guess=None, review_order=None, settings=Solver
     ``observe(impulse, vel, spin) -> 1-D array``: the figure's observable, scaled to
     order one; NLGS then runs in chunks of ``settings.check_every`` sweeps and the run
     is converged only when it has settled too (:mod:`ncd.convergence`)."""
+    checks.step_problem(scene, problem)   # guess, review_order, settings: in solve_discs
     vel = problem.free_vel.copy()
     spin = problem.free_spin.copy()
     result = solve_discs(scene, problem.contacts, vel, spin, guess, review_order, settings,
@@ -113,6 +118,8 @@ def solve_problem(scene, problem, guess=None, review_order=None, settings=Solver
 
 def initial_guess(scene, problem, init):
     """``init``: "zero", "warm" (previous impulses matched by body pair) or an array."""
+    if not isinstance(init, str):
+        return checks.impulse_guess("init", init, problem.contacts.n)
     if isinstance(init, str):
         if init == "zero":
             return None
@@ -125,6 +132,7 @@ def initial_guess(scene, problem, init):
 def step(scene, h, theta=0.5, settings=SolverSettings(), init="warm", review_order=None,
          gap_tolerance=None, speed_limit=np.inf):
     """Advance ``scene`` by one Moreau-Jean step in place; returns a :class:`StepReport`."""
+    h, theta = checks.step_call(scene, h, theta, settings, init, gap_tolerance, speed_limit)
     problem = prepare_step(scene, h, theta, gap_tolerance)
     guess = initial_guess(scene, problem, init)
     result, vel, spin = solve_problem(scene, problem, guess, review_order, settings)
@@ -165,6 +173,7 @@ def equilibrium_test(scene, h, settings=SolverSettings(), init="zero", review_or
 
     The scene is not modified.  The contact forces are ``r = s / h``.
     """
+    h, _ = checks.step_call(scene, h, 1.0, settings, init, gap_tolerance, velocity_tol=velocity_tol)
     zero_v = np.zeros_like(scene.vel)
     zero_w = np.zeros_like(scene.spin)
     problem = prepare_step(scene, h, 1.0, gap_tolerance, vel=zero_v, spin=zero_w)
@@ -177,7 +186,9 @@ def equilibrium_test(scene, h, settings=SolverSettings(), init="zero", review_or
     return EquilibriumResult(rel <= velocity_tol, rel, result.impulse / h, problem.contacts, result)
 
 
+@checks.finite_value
 def kinetic_energy(scene):
+    checks.scene(scene, state=True)
     nm = scene.n_mobile
     m = scene.mass[:nm]
     inertia = 0.5 * m * scene.radius[:nm] ** 2
