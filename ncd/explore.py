@@ -19,6 +19,7 @@ import numba
 import numpy as np
 
 from . import checks
+from .convergence import SPEED_TOL, classify, max_speed
 from .nlgs import SolverSettings
 from .stepper import initial_guess, solve_problem
 
@@ -71,12 +72,16 @@ def run_parallel(task, n, threads=None, progress=None):
 
 
 def explore(scene, problem, members, root_seed, init="zero", review="random", guess_scale=None,
-            settings=SolverSettings(), progress=None, threads=None):
+            settings=SolverSettings(), progress=None, threads=None, observe=None, speed_tol=SPEED_TOL):
     """Run one NLGS per member on ``problem``; returns a dict of arrays stacked over members.
 
     ``init``: "zero", "warm" (the scene's previous impulses) or "random"
     (:func:`random_guess` with ``guess_scale``); ``review``: "fixed" or "random".
     ``progress(done, total)`` is called now and then; ``threads``: see :func:`run_parallel`.
+    ``observe``: the figure's observable (:func:`ncd.stepper.solve_problem`).  Each run is
+    classified (:func:`ncd.convergence.classify`): ``outcome`` 0 unconverged, 1 rest,
+    2 motion (``max_speed`` above ``speed_tol``), with ``max_speed`` (largest grain
+    speed over ``|g| h``).
     """
     members = checks.explore_args(scene, problem, members, root_seed, init, review, guess_scale,
                                   settings, progress, threads)
@@ -97,6 +102,10 @@ def explore(scene, problem, members, root_seed, init="zero", review="random", gu
         "residual": np.zeros(len(members)),
         "change": np.zeros(len(members)),
         "converged": np.zeros(len(members), bool),
+        "outcome": np.zeros(len(members), np.int8),
+        "max_speed": np.zeros(len(members)),
+        "observable_change": np.zeros(len(members)),
+        "finish_rounds": np.zeros(len(members), np.int64),
         "wall_time": np.zeros(len(members)),
     }
     warm = initial_guess(scene, problem, "warm") if init == "warm" else None
@@ -107,7 +116,7 @@ def explore(scene, problem, members, root_seed, init="zero", review="random", gu
         guess = warm if init == "warm" else (
             random_guess(rng, problem.contacts.mu, guess_scale) if init == "random" else None)
         t0 = time.perf_counter()
-        result, vel, spin = solve_problem(scene, problem, guess, order, settings)
+        result, vel, spin = solve_problem(scene, problem, guess, order, settings, observe)
         out["wall_time"][k] = time.perf_counter() - t0
         out["impulse"][k] = result.impulse
         out["vel"][k] = vel[:nm]
@@ -116,6 +125,10 @@ def explore(scene, problem, members, root_seed, init="zero", review="random", gu
         out["residual"][k] = result.residual
         out["change"][k] = result.change
         out["converged"][k] = result.converged
+        out["outcome"][k] = classify(result, vel, spin, scene, problem.h, speed_tol)
+        out["max_speed"][k] = max_speed(vel, spin, scene, problem.h)
+        out["observable_change"][k] = result.observable_change
+        out["finish_rounds"][k] = result.finish_rounds
 
     run_parallel(run, len(members), threads, progress)
     return out

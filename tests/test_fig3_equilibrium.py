@@ -171,6 +171,18 @@ def test_converged_runs_are_equilibria_inside_the_exact_polygons(fig3):
         assert outside_distance(pts, fe.polygon(pr, k)).max() <= 1e-4 * P.scale, f"contact {k}"
 
 
+def test_runs_are_classified(fig3):
+    """outcome (ncd.convergence): rest = converged and every grain slower than the stated
+    bound; the clouds use the rest-state runs only."""
+    ens = fig3["ensemble"]
+    tol = fig3["cfg"]["packing"]["velocity_tol"]
+    conv = ens.converged.values == 1
+    np.testing.assert_array_equal(ens.outcome.values == 1, conv & (ens.max_speed.values <= tol))
+    np.testing.assert_array_equal(ens.outcome.values == 0, ~conv)
+    assert ens.outcome.attrs["flag_meanings"] == "unconverged rest motion"
+    assert (ens.outcome.values == 1).mean() >= 0.99
+
+
 def test_cloud_measures_of_the_displayed_contacts(fig3):
     ens, pr = fig3["ensemble"], fig3["projection"]
     shown = np.nonzero(pr.displayed.values)[0]

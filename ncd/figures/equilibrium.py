@@ -16,6 +16,7 @@ import numpy as np
 import xarray as xr
 
 from ..contacts import h_matrix, match_warm
+from ..convergence import MAX_SPEED_ATTRS, REST, outcome_attrs
 from ..explore import explore, member_rng, shard_members
 from ..io import provenance
 from ..nlgs import SolverSettings
@@ -180,8 +181,9 @@ def run_ensemble(state, cfg, mode, shard, n_shards, progress=None):
     members = runs[shard_members(len(runs), shard, n_shards)]
     h = state.attrs["h"]
     settings = _settings(cfg)
+    # at rest: |u_f| <= velocity_tol |g| h, the bound of the deposition's equilibrium test
     out = explore(scene, problem, members, cfg["root_seed"], settings=settings, progress=progress,
-                  **_mode_args(state, cfg, mode))
+                  speed_tol=cfg["packing"]["velocity_tol"], **_mode_args(state, cfg, mode))
     g = float(np.linalg.norm(scene.gravity))
     umax = np.maximum(np.abs(out["vel"]).max(axis=(1, 2)),
                       np.abs(out["spin"] * scene.radius[None, :scene.n_mobile]).max(axis=1)) / (g * h)
@@ -191,6 +193,8 @@ def run_ensemble(state, cfg, mode, shard, n_shards, progress=None):
          "sweeps": ("run", out["sweeps"]), "residual": ("run", out["residual"]),
          "change": ("run", out["change"]), "converged": ("run", out["converged"].astype(np.int8)),
          "wall_time": ("run", out["wall_time"]), "max_velocity": ("run", umax),
+         "outcome": ("run", out["outcome"], outcome_attrs()),
+         "max_speed": ("run", out["max_speed"], dict(MAX_SPEED_ATTRS)),
          "mode": ("run", np.full(len(members), MODES.index(mode), np.int8))},
         coords={"run": members, "contact": np.arange(problem.contacts.n)},
         attrs=provenance(cfg, settings, h=h))
@@ -326,8 +330,9 @@ def cloud_measures(ensemble, projection, uniform, contacts, band=0.05):
         poly = polygon(projection, k)
         area = float(projection.area[k])
         for name, ds in groups:
-            if name != "uniform":
-                ds = ds.isel(run=np.nonzero(ds.converged.values == 1)[0])
+            if name != "uniform":       # converged runs at rest only (ncd.convergence)
+                rest = ds.outcome.values == REST if "outcome" in ds else ds.converged.values == 1
+                ds = ds.isel(run=np.nonzero(rest)[0])
             pts = np.column_stack([ds.force_n.values[:, k], ds.force_t.values[:, k]])
             dist = boundary_distance(pts, poly)
             rows.append({"contact": int(k), "mode": name, "points": len(pts),
