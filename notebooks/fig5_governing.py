@@ -98,11 +98,11 @@ for k in kinds:
     dr = fg.eta_table(ds, "dim_ratio", k)
     ff = fg.eta_table(ds, "fixed_fraction", k)
     text.append(
-        f"**{name}** ({int(te[:, 3].min())}–{int(te[:, 3].max())} packings per μ). "
-        f"Exact η rises from {te[0, 1]:.3g} at μ = {te[0, 0]:.3g} to its largest mean "
+        f"**{name}** ({int(te[:, 3].min())}–{int(te[:, 3].max())} packings per μ with a bounded A ∩ C). "
+        f"Exact η: {te[0, 1]:.3g} at μ = {te[0, 0]:.3g}, largest mean "
         f"{np.nanmax(te[:, 1]):.3g} at μ = {pe:.3g} (Unger et al.: peak near 0.1) and is {te[-1, 1]:.3g} at "
         f"μ = {te[-1, 0]:.3g}; log-log slope over the two smallest μ: {se:.2f} (Unger et al.: 1). "
-        f"Unger et al.'s η measured their way: {tu[0, 1]:.3g} → largest {np.nanmax(tu[:, 1]):.3g} at μ = {pu:.3g}, "
+        f"Unger et al.'s η measured their way: {tu[0, 1]:.3g} at the smallest μ, largest {np.nanmax(tu[:, 1]):.3g} at μ = {pu:.3g}, "
         f"slope {su:.2f}; it is {np.nanmedian(ds.eta_unger.values[ds.kind.values == k] / ds.eta_exact.values[ds.kind.values == k]):.2f} "
         f"times the exact η (median over packings). "
         f"Coordination 2κ/N falls from {z[0, 1]:.2f} to {z[-1, 1]:.2f}; dim(A∩C)/2κ goes from "
@@ -115,15 +115,22 @@ k0 = kinds[0]
 te, tu = fg.eta_table(ds, "eta_exact", k0), fg.eta_table(ds, "eta_unger", k0)
 (pe, se), (pu, su) = fg.peak_and_slope(te), fg.peak_and_slope(tu)
 grid = np.unique(ds.mu.values)
-near = lambda m: abs(np.log10(m / gp.UNGER_PEAK_MU)) <= np.log10(grid[1] / grid[0]) + 1e-9  # within one grid step
+nearest = grid[np.argmin(np.abs(np.log(grid / gp.UNGER_PEAK_MU)))]   # the grid point nearest mu = 0.1
+
+
+def where(m):
+    if m == grid.max():
+        return "the largest μ of the grid: no peak inside the range studied"
+    return "the grid point nearest Unger et al.'s 0.1" if m == nearest else f"not the grid point nearest 0.1 ({nearest:.3g})"
+
+
 display(Markdown(
-    f"**Where we agree and differ ({fg.KINDS[k0]}).** Peak of the exact η at μ = {pe:.3g}: "
-    f"{'within one grid step of' if near(pe) else 'not near'} Unger et al.'s μ ≈ 0.1; peak of η measured "
-    f"their way at μ = {pu:.3g}: {'within one grid step of' if near(pu) else 'not near'} it. Small-μ log-log "
+    f"**Where we agree and differ ({fg.KINDS[k0]}).** Largest mean exact η at μ = {pe:.3g}: {where(pe)}; "
+    f"largest mean η measured their way at μ = {pu:.3g}: {where(pu)}. Small-μ log-log "
     f"slope: exact {se:.2f}, their way {su:.2f}, against their η ∝ μ (slope 1). "
     f"The exact η is the full extent of the solution set along each contact (an upper envelope of any sampling); "
     f"{cfg['unger']['rounds']} noise-and-relax rounds travel only part of it (median ratio printed above). "
     f"Built-in differences: a body-force load (stress growing with depth) instead of a lid, the whole "
     f"packing instead of a bulk slice with fixed boundary forces, and {int(te[:, 3].min())}–{int(te[:, 3].max())} "
-    f"packings per μ at the default size. Not in this figure yet: the flows across μ, h and slope angle and the "
+    f"packings per μ in this run. Not in this figure yet: the flows across μ, h and slope angle and the "
     f"analysis of why a dispersion is a line (items 2 and 3 of issue 15)."))

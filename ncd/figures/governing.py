@@ -336,7 +336,8 @@ def eta_table(ds, var="eta_exact", kind=0):
 def peak_and_slope(table):
     """``(mu at the largest mean, slope of log eta against log mu over the two smallest mu)``."""
     mu, m = table[:, 0], table[:, 1]
-    slope = float(np.diff(np.log(m[:2])) / np.diff(np.log(mu[:2]))) if len(mu) > 1 and (m[:2] > 0).all() else np.nan
+    ok = len(mu) > 1 and bool((m[:2] > 0).all())
+    slope = float(np.log(m[1] / m[0]) / np.log(mu[1] / mu[0])) if ok else np.nan
     return float(mu[np.nanargmax(m)]), slope
 
 

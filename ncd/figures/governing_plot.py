@@ -43,8 +43,8 @@ def panel_coordination(ax, ds):
     """(c) coordination 2 kappa / N against mu (Unger et al.: eta falls as it drops)."""
     for k in sorted(set(ds.kind.values.tolist())):
         _band(ax, eta_table(ds, "coordination", k), KINDS[k], f"C{2 * k}")
-    ax.axhline(3.0, color="k", ls=":", lw=1, label="z = 3 (isostatic, μ → ∞)")
-    ax.axhline(4.0, color="k", ls="--", lw=1, label="z = 4 (isostatic, μ = 0)")
+    ax.axhline(3.0, color="k", ls=":", lw=1, label="z = 3 (bulk isostatic, μ → ∞)")
+    ax.axhline(4.0, color="k", ls="--", lw=1, label="z = 4 (bulk isostatic, μ = 0)")
     ax.set(xscale="log", xlabel="μ", ylabel="2κ / N", title="(c) coordination")
     ax.legend(fontsize=7)
 
