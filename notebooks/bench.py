@@ -58,10 +58,11 @@ from IPython.display import display, Markdown
 from ncd.notebook import paths, save
 
 # Snakemake's object, or by hand (from the repository or notebooks/) the files under results/
-snakemake = paths("bench", ["core", "sweeps", "ensemble", "peer", "rules"], globals().get("snakemake"))
+snakemake = paths("bench", ["core", "sweeps", "tolerance", "ensemble", "peer", "rules"], globals().get("snakemake"))
 
 core = xr.load_dataset(snakemake.input.core)
 sweeps = xr.load_dataset(snakemake.input.sweeps)
+tol_ds = xr.load_dataset(snakemake.input.tolerance)
 ens = xr.load_dataset(snakemake.input.ensemble)
 peer = xr.load_dataset(snakemake.input.peer)
 rules = xr.load_dataset(snakemake.input.rules)
@@ -177,6 +178,20 @@ display(Markdown(
     f"Chipmunk pushes overlaps out over later steps (its bias velocities), which also keeps its "
     f"pile creeping (final kinetic energy {float(p_.kinetic_energy):.1e} against "
     f"{float(n_.kinetic_energy):.1e} of Σ m g d)."))
+
+# %% [markdown]
+# ## Time to tolerance: plain NLGS and NLGS + finishing stage
+#
+# One step from rest of each dense packing, zero guess: plain NLGS run to each tolerance,
+# and NLGS handed over to the active-set finishing stage (`ncd.finish`) at the hand-off
+# tolerance, polished to the same tolerance.
+
+# %%
+tt = tol_ds.to_dataframe().reset_index()
+display(tt.pivot_table(index=["size", "tol"], columns="solver", values=["seconds", "sweeps", "converged"]))
+fastest = tt.loc[tt.groupby(["size", "tol"]).seconds.idxmin()]
+display(Markdown("Fastest to each tolerance: " + "; ".join(
+    f"{r.size} discs, {r.tol:.0e}: {r.solver} ({r.seconds:.2f} s)" for r in fastest.itertuples()) + "."))
 
 # %% [markdown]
 # ## Wall time of every rule of the figures' run

@@ -127,3 +127,14 @@ def test_bench_rules_cover_every_figure(bench_results):
         names = set(rules.rule.values[rules.figure.values == fig])
         assert any(n.endswith("notebook") for n in names), (fig, names)
     assert (rules.seconds > 0).all()
+
+
+def test_tolerance_table_both_methods_reach_the_tolerance():
+    """Time to tolerance (issue 13): plain NLGS and NLGS + finishing stage, side by side."""
+    from ncd.studies.bench import tolerance_table
+    ds = tolerance_table({"sizes": [100], "tolerances": [1e-6, 1e-10], "handoff": 1e-4, "max_sweeps": 100000})
+    assert ds.converged.values.all()
+    assert (ds.residual.values <= ds.tol.values[None, None, :]).all()
+    assert (ds.finish_rounds.sel(solver="nlgs").values == 0).all()
+    assert (ds.finish_rounds.sel(solver="nlgs+finish").values >= 1).all()
+    assert ds.seconds.attrs["units"] == "s"

@@ -246,6 +246,42 @@ def sweeps_table(cfg, log=None):
     return ds
 
 
+def tolerance_table(cfg, log=None):
+    """Time to tolerance, plain NLGS and NLGS + finishing stage side by side: one step
+    from rest of each dense packing, zero guess, identity review order.  Plain NLGS runs
+    to each ``tolerances`` value; the finished run hands over at ``handoff`` and polishes
+    to the same value (``finish="active_set"``, :mod:`ncd.finish`).  -> Dataset
+    (size, solver, tol): seconds, sweeps, residual, converged, finish rounds."""
+    sizes, tols, methods = cfg["sizes"], cfg["tolerances"], ["nlgs", "nlgs+finish"]
+    shape = (len(sizes), len(methods), len(tols))
+    out = {k: np.zeros(shape) for k in ("seconds", "residual")}
+    out.update({k: np.zeros(shape, np.int64) for k in ("sweeps", "converged", "finish_rounds")})
+    for i, n in enumerate(sizes):
+        scene = dense_packing(n)
+        problem = prepare_step(scene, H)
+        solve_problem(scene, problem, settings=SolverSettings(tol=1.0, max_sweeps=1))    # warm-up
+        for j, method in enumerate(methods):
+            for k, tol in enumerate(tols):
+                if method == "nlgs":
+                    settings = SolverSettings(tol=tol, max_sweeps=cfg["max_sweeps"], check_every=10)
+                else:
+                    settings = SolverSettings(tol=max(tol, cfg["handoff"]), max_sweeps=cfg["max_sweeps"],
+                                              check_every=10, finish="active_set", finish_tol=tol)
+                t0 = time.perf_counter()
+                r, _, _ = solve_problem(scene, problem, settings=settings)
+                out["seconds"][i, j, k] = time.perf_counter() - t0
+                out["sweeps"][i, j, k], out["residual"][i, j, k] = r.sweeps, r.residual
+                out["converged"][i, j, k], out["finish_rounds"][i, j, k] = r.converged, r.finish_rounds
+                if log:
+                    log.info("%d discs, %s, tol %.0e: %.3f s, %d sweeps, residual %.2e", n, method, tol,
+                             out["seconds"][i, j, k], r.sweeps, r.residual)
+    units = {"seconds": ("s", "wall time to reach the tolerance"), "residual": ("1", "relative natural-map residual"),
+             "sweeps": ("1", "NLGS sweeps"), "converged": ("1", "residual <= tolerance (1) or not (0)"),
+             "finish_rounds": ("1", "active-set rounds of the finishing stage")}
+    return xr.Dataset({k: (("size", "solver", "tol"), v, {"units": units[k][0], "long_name": units[k][1]})
+                       for k, v in out.items()},
+                      coords={"size": sizes, "solver": methods, "tol": tols})
+
 def _digest(out):
     h = hashlib.sha256()
     for k in ("impulse", "vel", "spin", "sweeps", "residual", "change", "converged"):

@@ -2,6 +2,7 @@
 #   core      ns per contact update (numba and the same loop in C), detection,
 #             time per step and memory on dense packings       -> results/bench/core.nc
 #   sweeps    sweeps to a fixed tolerance against N             -> results/bench/sweeps.nc
+#   tolerance time to 1e-6/1e-8/1e-10, NLGS and NLGS + finish -> results/bench/tolerance.nc
 #   ensemble  NLGS ensemble on 1 and 2 threads                  -> results/bench/ensemble.nc
 #   peer      ncd and pymunk side by side on a poured pile      -> results/bench/peer.nc
 #   rules     wall time of every rule of the figures' run       -> results/bench/rules.nc
@@ -47,6 +48,24 @@ rule bench_sweeps:
         CONDA_ENV
     script:
         "../scripts/bench_sweeps.py"
+
+
+rule bench_tolerance:
+    input:
+        ncd_sources(FIGB),
+    output:
+        "results/bench/tolerance.nc",
+    threads: BENCH_THREADS
+    params:
+        config=CFGB["tolerance"],
+    log:
+        log(FIGB, "tolerance"),
+    benchmark:
+        bench(FIGB, "tolerance")
+    conda:
+        CONDA_ENV
+    script:
+        "../scripts/bench_tolerance.py"
 
 
 rule bench_ensemble:
@@ -108,6 +127,7 @@ rule bench_notebook:
     input:
         core="results/bench/core.nc",
         sweeps="results/bench/sweeps.nc",
+        tolerance="results/bench/tolerance.nc",
         ensemble="results/bench/ensemble.nc",
         peer="results/bench/peer.nc",
         rules="results/bench/rules.nc",
