@@ -70,7 +70,7 @@ class SolverSettings:
                 raise ValueError(f"{name} = {getattr(self, name)!r} must be > 0")
 
     def as_attrs(self):
-        return {f"solver_{k}": v for k, v in asdict(self).items()}
+        return {f"solver_{k}": int(v) if isinstance(v, bool) else v for k, v in asdict(self).items()}
 
 
 @dataclass
