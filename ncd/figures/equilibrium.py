@@ -214,7 +214,8 @@ def convergence_history(state, cfg, mode, run, sweeps):
     base = _settings(cfg)
     rows = []
     for k in [1, *sweeps]:          # the first, discarded, replay compiles and warms the caches
-        s = SolverSettings(tol=1e-300, max_sweeps=int(k), criterion=base.criterion, check_every=base.check_every)
+        s = SolverSettings(tol=1e-300, max_sweeps=int(k), criterion=base.criterion, check_every=base.check_every,
+                           keep_best=False)      # the iterate after k sweeps, not the best so far
         out = explore(scene, problem, [run], cfg["root_seed"], settings=s, **_mode_args(state, cfg, mode))
         rows.append((int(out["sweeps"][0]), float(out["residual"][0]), float(out["wall_time"][0])))
     return np.array(rows[1:])
