@@ -15,7 +15,7 @@ Every call must end in one of
 * :class:`ncd.InputError` or :class:`ncd.SimulationError` with a message.
 
 The batches run in subprocesses (a few entry points each, to amortise the numba
-import), so a segfault or abort is a test failure naming the last call, not a
+import; two at a time), so a segfault or abort is a test failure naming the last call, not a
 dead runner; each subprocess has a timeout and every solve a bounded sweep
 budget (``max_sweeps <= 300``, so no hang).  The subprocesses run with
 ``NUMBA_BOUNDSCHECK=1`` and their own ``NUMBA_CACHE_DIR`` (a temporary
@@ -401,28 +401,39 @@ def run_batch(entries, calls, seed, log):
 
 
 # ------------------------------------------------------------------ the test
-@pytest.fixture(scope="module")
-def numba_cache(tmp_path_factory):
-    """A cache directory of kernels compiled with bounds checks, shared by the batches."""
-    return tmp_path_factory.mktemp("numba_boundscheck")
-
-
-@pytest.mark.parametrize("batch", list(BATCHES))
-def test_fuzz(batch, numba_cache, tmp_path):
+def run_subprocess(batch, numba_cache, log):
+    """One batch in a fresh interpreter; returns ``(returncode or "timeout", stdout, stderr)``."""
     entries = BATCHES[batch]
-    log = tmp_path / "calls.log"
     env = dict(os.environ, NUMBA_BOUNDSCHECK="1", NUMBA_CACHE_DIR=str(numba_cache))
     cmd = [sys.executable, __file__, ",".join(entries), str(CALLS), str(list(BATCHES).index(batch)), str(log)]
     try:
         proc = subprocess.run(cmd, capture_output=True, text=True, timeout=TIMEOUT, env=env,
                               cwd=Path(__file__).resolve().parents[1])
     except subprocess.TimeoutExpired:
-        last = log.read_text().splitlines()[-1:] if log.exists() else []
-        pytest.fail(f"batch {batch} hung (> {TIMEOUT} s); last call: {last}")
+        return "timeout", "", ""
+    return proc.returncode, proc.stdout, proc.stderr
+
+
+@pytest.fixture(scope="module")
+def fuzz_runs(tmp_path_factory):
+    """All batches, two at a time (two cores), sharing one cache of kernels compiled
+    with bounds checks (a temporary NUMBA_CACHE_DIR)."""
+    from concurrent.futures import ThreadPoolExecutor
+    numba_cache = tmp_path_factory.mktemp("numba_boundscheck")
+    logs = {b: tmp_path_factory.mktemp(f"fuzz_{b}") / "calls.log" for b in BATCHES}
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        futures = {b: pool.submit(run_subprocess, b, numba_cache, logs[b]) for b in BATCHES}
+        return {b: f.result() + (logs[b],) for b, f in futures.items()}
+
+
+@pytest.mark.parametrize("batch", list(BATCHES))
+def test_fuzz(batch, fuzz_runs):
+    entries = BATCHES[batch]
+    rc, stdout, stderr, log = fuzz_runs[batch]
     last = log.read_text().splitlines()[-1:] if log.exists() else []
-    assert proc.returncode == 0, (f"batch {batch} died with rc {proc.returncode} during {last}:\n"
-                                  f"{proc.stderr[-3000:]}")
-    report = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert rc != "timeout", f"batch {batch} hung (> {TIMEOUT} s); last call: {last}"
+    assert rc == 0, f"batch {batch} died with rc {rc} during {last}:\n{stderr[-3000:]}"
+    report = json.loads(stdout.strip().splitlines()[-1])
     print(json.dumps(report["tally"], indent=1))
     assert report["n_failures"] == 0, "\n".join(report["failures"])
     for entry in entries:
