@@ -63,9 +63,14 @@ def _velocity_error(s, problem, vel, spin, vel_ref, spin_ref):
     return float(d / (np.linalg.norm(s.gravity) * problem.h))
 
 
+FINISH_HANDOFF = 1e-4     # NLGS tolerance handed to the finishing stage (criterion "finish")
+
+
 def nlgs_work_precision(s, h, tols, inits, criteria, reference, repeats, max_sweeps):
     """All settings on the core problem of the next step of ``s``; a Dataset with
-    dimensions ``(init, criterion, tol)``."""
+    dimensions ``(init, criterion, tol)``.
+    Criterion ``"finish"``: NLGS to ``max(tol, FINISH_HANDOFF)``, then the active-set
+    finishing stage (:mod:`ncd.finish`) to ``tol``."""
     problem = prepare_step(s, h)
     guesses = {init: initial_guess(s, problem, init) for init in inits}
     ref_settings = SolverSettings(tol=reference["tol"], max_sweeps=reference["max_sweeps"])
@@ -78,7 +83,9 @@ def nlgs_work_precision(s, h, tols, inits, criteria, reference, repeats, max_swe
         norm = max(np.linalg.norm(s_ref.impulse), 1e-300)
         for j, crit in enumerate(criteria):
             for k, tol in enumerate(tols):
-                settings = SolverSettings(tol=tol, max_sweeps=max_sweeps, criterion=crit)
+                settings = (SolverSettings(tol=max(tol, FINISH_HANDOFF), max_sweeps=max_sweeps, finish="active_set",
+                                           finish_tol=tol) if crit == "finish"
+                            else SolverSettings(tol=tol, max_sweeps=max_sweeps, criterion=crit))
                 best = np.inf
                 for _ in range(repeats):
                     t0 = time.perf_counter()
