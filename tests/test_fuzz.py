@@ -415,15 +415,35 @@ def run_subprocess(batch, numba_cache, log):
 
 
 @pytest.fixture(scope="module")
-def fuzz_runs(tmp_path_factory):
+def numba_cache(tmp_path_factory):
+    """A temporary NUMBA_CACHE_DIR for kernels compiled with bounds checks."""
+    return tmp_path_factory.mktemp("numba_boundscheck")
+
+
+@pytest.fixture(scope="module")
+def fuzz_runs(numba_cache, tmp_path_factory):
     """All batches, two at a time (two cores), sharing one cache of kernels compiled
-    with bounds checks (a temporary NUMBA_CACHE_DIR)."""
+    with bounds checks."""
     from concurrent.futures import ThreadPoolExecutor
-    numba_cache = tmp_path_factory.mktemp("numba_boundscheck")
     logs = {b: tmp_path_factory.mktemp(f"fuzz_{b}") / "calls.log" for b in BATCHES}
     with ThreadPoolExecutor(max_workers=2) as pool:
         futures = {b: pool.submit(run_subprocess, b, numba_cache, logs[b]) for b in BATCHES}
         return {b: f.result() + (logs[b],) for b, f in futures.items()}
+
+
+def test_harness_turns_an_out_of_range_kernel_index_into_an_error(numba_cache):
+    """The harness itself: with NUMBA_BOUNDSCHECK=1 the NLGS kernel reached with
+    review order [0, 1, 10**6] (bypassing the checks) raises IndexError, where the
+    unchecked build read out of bounds (segfault of issue 14)."""
+    code = ("import numpy as np\nimport ncd.nlgs as m, scipy.sparse as sp\n"
+            "W = sp.csr_matrix(2.0 * np.eye(6)); q = -np.ones(6); Wd = np.tile(2.0 * np.eye(2), (3, 1, 1))\n"
+            "data = (W.indptr.astype(np.int64), W.indices.astype(np.int64), W.data, q, Wd, np.full(3, 0.5), np.zeros(6))\n"
+            "try:\n    m._sweep_local(data, np.array([0, 1, 10**6]), np.zeros(3, np.int8))\n"
+            "except IndexError as err:\n    print('IndexError', err)\n")
+    env = dict(os.environ, NUMBA_BOUNDSCHECK="1", NUMBA_CACHE_DIR=str(numba_cache))
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=TIMEOUT, env=env)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert proc.stdout.startswith("IndexError"), proc.stdout
 
 
 @pytest.mark.parametrize("batch", list(BATCHES))
