@@ -106,6 +106,8 @@ rule fig2_slope_census:
         log(FIG2, "census"),
     benchmark:
         bench(FIG2, "census")
+    conda:
+        CONDA_ENV
     script:
         "../scripts/fig2_slope_census.py"
 

@@ -68,6 +68,8 @@ rule fig4_pile_exact:
         log(FIG4, "exact"),
     benchmark:
         bench(FIG4, "exact")
+    conda:
+        CONDA_ENV
     script:
         "../scripts/fig4_pile_exact.py"
 
