@@ -20,8 +20,8 @@ method on the natural map):
    ``z = s - rho (U_n + mu |U_t|, U_t)`` (inside the cone: stick; in its polar:
    open; else slide) and repeats until they stop changing; the candidate is
    accepted only if its relative natural-map residual is ``<= finish_tol``;
-4. otherwise returns to NLGS sweeps (doubling chunks, within the sweep budget)
-   and tries again from the new iterate.
+4. otherwise returns to NLGS sweeps (chunks growing 4x, within the sweep budget)
+   and tries again from the new iterate (accepted as is if it reaches ``finish_tol``).
 
 :func:`check_solution` checks an accepted solution componentwise (cone,
 complementarity, sticking and sliding velocities).
@@ -33,7 +33,7 @@ import scipy.sparse.linalg as spla
 from .contacts import h_matrix
 from .local_solver import NO_CONTACT, SLIDE_BACKWARD, SLIDE_FORWARD, STICK
 
-SWITCH_ROUNDS = 8        # status switches per attempt before returning to NLGS sweeps
+SWITCH_ROUNDS = 4        # status switches per attempt before returning to NLGS sweeps
 REFINE = 30              # iterated-Tikhonov refinements of one minimum-norm correction
 
 
@@ -133,6 +133,8 @@ def polish(W, q, mu, rho, scale, s0, status0, tol, more_sweeps=None, max_sweeps=
         res = relative_residual(s_base, U, mu, rho, scale)
         if res < best[0]:
             best = (res, s_base, status)
+        if res <= tol:                   # NLGS got there by itself
+            return s_base, status, res, rounds, True, extra
         seen = set()
         for _ in range(SWITCH_ROUNDS):
             rounds += 1
@@ -155,7 +157,7 @@ def polish(W, q, mu, rho, scale, s0, status0, tol, more_sweeps=None, max_sweeps=
         s_base, status = more_sweeps(k)
         status = np.where(status > SLIDE_BACKWARD, STICK, status).astype(np.int8)
         extra += k
-        chunk *= 2
+        chunk *= 4
 
 
 def check_solution(impulse, U, mu, tol=1e-8, velocity_scale=None):
