@@ -37,8 +37,8 @@
 #
 # Every pile is stepped until the warm equilibrium test of section 2 passes; its
 # forces are the history forces. Per pile: the ground stress profile (Gaussian kernel
-# average of the ground-contact forces against $x / L$, $L$ the pile's base
-# half-width from its flank fits, in units of the mean stress $W / 2L$), the dip depth
+# average of the ground-contact forces against $x / L$, $L$ the base half-width of the
+# member's point-source pile from its flank fits, in units of the mean stress $W / 2L$), the dip depth
 # $(M - m)/M$ (central minimum $m$ against the neighbouring maxima $M$; negative: a
 # hump), and the resultant across vertical cuts along both flanks with its angle to
 # the pile's own free surface. Bands are bootstrap resamples of the **piles**.
@@ -83,11 +83,14 @@ fig.savefig(out.pdf, metadata={"CreationDate": None})
 P, R = s["point"], s["rain"]
 k = s["kernel"]
 display(Markdown(f"""
-**Shapes.** The point-source piles have a base half-width of {P['L']:.1f} mean diameters
-and flanks at {P['slope']:.1f}° on average. The rain falls over that width on an
-unbounded ground and builds a flat-topped deposit whose toes reach {R['L']:.1f} d
-(flanks {R['slope']:.1f}°): raining onto a ground wider than the rain does not build a
-cone, unlike the experiments, where the rain covers a base of finite size.
+**Shapes.** The point-source piles have a base half-width $L$ of {P['L']:.1f} mean diameters,
+an apex {P['apex']:.1f} d above the ground and flanks at {P['slope']:.1f}° on average. The rain
+falls over $|x| \\le L$ onto the same unbounded ground; the rained deposits are
+{R['apex']:.1f} d high with fitted flanks of {R['slope']:.1f}° and toes {R['fitL']:.1f} d from the
+axis: {'a layer spread beyond the rain, not a heap' if R['slope'] < 0.5 * P['slope'] else 'heaps'}.
+In the experiments the rain covers a base of finite size, off which the excess grains fall;
+that construction is not the one simulated here. Both histories are drawn against $x / L$
+with the $L$ of the member's point-source pile.
 
 **Ground stress ({s['piles']} piles per history, kernel {k:g} d).** Dip depth of the
 mean profile: point source {P['dip']:.3f} (95 % band {P['lo']:.3f} to {P['hi']:.3f}),
@@ -98,6 +101,10 @@ their own. The difference point − rain is {s['diff']:.3f} (band {s['diff_lo']:
 dips of the mean profiles are
 {', '.join(f"{kk:g} d: {P['dips_by_kernel'][kk]:.3f} / {R['dips_by_kernel'][kk]:.3f}" for kk in P['dips_by_kernel'])}
 (point / rain), p = {', '.join(f"{s['p'][kk]:.3g}" for kk in s['p'])}.
+A single pile's dip is a minimum of a noisy curve against maxima of the same curve, so it
+is biased upwards when the kernel is narrow: the fraction of piles with a dip of their own is
+{', '.join(f"{kk:g} d: {100 * P['frac_by_kernel'][kk]:.0f} % / {100 * R['frac_by_kernel'][kk]:.0f} %" for kk in P['frac_by_kernel'])}
+(point / rain); only the mean profile over piles, with its band, carries a claim.
 Under the apex the mean stress is {P['center']:.2f} (point) and {R['center']:.2f} (rain)
 times the mean stress W / 2L.
 

@@ -2,9 +2,10 @@
 
 Per pile (history forces: the warm-started equilibrium test of its final state):
 
-* ground stress profile ``p(xi)``, ``xi = x / L`` (``L`` the pile's base half-width,
-  ``x = 0`` the source axis): a Gaussian kernel average of the vertical forces of
-  the ground contacts, standard deviation ``w`` mean diameters, normalised by the
+* ground stress profile ``p(xi)``, ``xi = x / L`` (``L`` the base half-width of the
+  member's point-source pile, :func:`norm_length`; ``x = 0`` the source axis): a
+  Gaussian kernel average of the vertical forces of the ground contacts, standard
+  deviation ``w`` mean diameters, normalised by the
   mean ground stress ``W / (2 L)`` (``W`` the weight), so ``p = 1`` is the weight
   spread evenly over the base;
 * dip depth ``(M - m) / M``: ``m`` the central minimum of ``p`` (``|xi| <= dip_center``),
@@ -46,11 +47,20 @@ def dip_depth(profile, xi, center, flank):
     return ((big - m) / big).reshape(np.shape(profile)[:-1])
 
 
+def norm_length(cfg, ds):
+    """``L`` of ``xi = x / L``: the base half-width of the member's point-source pile (for a
+    rain pile, the rain's half-width over ``rain.width_fraction``), so that both piles of a
+    member share the abscissa (a rained layer has no well-defined toe of its own)."""
+    if ds.attrs["history"] == "point":
+        return float(ds.attrs["base_half_width"])
+    return float(ds.attrs["rain_half_width"]) / cfg["rain"]["width_fraction"]
+
+
 def pile_measures(cfg, ds):
     """The measures of one pile file (see the module docstring)."""
     a = cfg["analysis"]
     d = mean_diameter(cfg)
-    L = float(ds.attrs["base_half_width"])
+    L = norm_length(cfg, ds)
     W = float(ds.attrs["weight"])
     xi = np.linspace(-a["xi_max"], a["xi_max"], a["n_xi"])
     x, fx, fy = ground_forces(ds)
@@ -66,10 +76,15 @@ def pile_measures(cfg, ds):
     outer = np.repeat([-1, 1], len(q))
     slope = np.where(outer > 0, ds.attrs["right_angle"], ds.attrs["left_angle"])
     phi, dev = cm.flank_angles(F[:, 0], F[:, 1], outer, slope)
+    dev = (dev + 180.0) % 360.0 - 180.0              # a deviation in (-180, 180]
+    apex = float(np.max(ds["y"].values + ds["radius"].values)) - float(ds.attrs["y_ground"])
+    tan = np.tan(np.radians(0.5 * (ds.attrs["left_angle"] + ds.attrs["right_angle"])))
+    fitL = float(ds.attrs["base_half_width"])
     return dict(xi=xi, profile=prof, ground_fx=float(fx.sum()), ground_fy=float(fy.sum()), weight=W,
                 base_half_width=L, n_ground=len(x), cut_angle=phi.reshape(2, -1), cut_deviation=dev.reshape(2, -1),
                 cut_count=np.asarray(counts).reshape(2, -1), surface_angle=slope.reshape(2, -1),
-                dip=dip_depth(prof, xi, a["dip_center"], a["dip_flank"]))
+                dip=dip_depth(prof, xi, a["dip_center"], a["dip_flank"]), apex_height=apex / d,
+                cone_ratio=apex / (fitL * tan), fit_half_width=float(ds.attrs["base_half_width"]))
 
 
 def bootstrap_index(rng, n_piles, n_boot):
@@ -152,11 +167,16 @@ def ensemble_dataset(cfg, files):
             "deviation_median_hi": one((H, F, Q), np.quantile(boot_med, hi, axis=1), "degree",
                                        "bootstrap band over piles of the median deviation, upper"),
             "surface_angle": one((H, P, F), stack("surface_angle")[..., 0], "degree", "flank slope of the pile"),
-            "base_half_width": one((H, P), stack("base_half_width"), "m", "base half-width L of the pile"),
+            "base_half_width": one((H, P), stack("base_half_width"), "m",
+                                   "L: base half-width of the member's point-source pile"),
+            "fit_half_width": one((H, P), stack("fit_half_width"), "m", "toe-to-toe half-width of the pile's own fit"),
             "weight": one((H, P), stack("weight"), "N", "weight of the pile"),
             "ground_fx": one((H, P), stack("ground_fx"), "N", "horizontal ground reaction"),
             "ground_fy": one((H, P), stack("ground_fy"), "N", "vertical ground reaction"),
             "n_ground": one((H, P), stack("n_ground"), "1", "ground contacts"),
+            "apex_height": one((H, P), stack("apex_height"), "1", "highest grain top above the ground, in d"),
+            "cone_ratio": one((H, P), stack("cone_ratio"), "1",
+                              "apex height / (L tan(mean flank angle)): 1 for a cone, < 1 flat-topped"),
         },
         coords={H: hist, P: np.arange(n), K: widths, X: xi, F: ["left", "right"], Q: q},
         attrs={"level": a["level"], "bootstrap": B, "permutations": a["permutations"],

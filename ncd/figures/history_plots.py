@@ -35,7 +35,7 @@ def plot_stress(ax, an, kernel=None):
         ax.plot(an.xi, s.profile_mean, color=COLORS[h],
                 label=f"{LABELS[h]} ({an.sizes['pile']} piles)")
     ax.axhline(1.0, color="0.6", lw=0.6, ls=":")
-    ax.set_xlabel("x / L (L: base half-width of the pile)")
+    ax.set_xlabel("x / L (L: base half-width of the point-source pile)")
     ax.set_ylabel("ground stress / (W / 2L)")
     ax.set_title(f"kernel {k:g} d, {int(100 * an.attrs['level'])} % bootstrap band over piles", fontsize=9)
     ax.legend(fontsize=8)
@@ -96,15 +96,20 @@ def figure(an, piles):
 def summary(an):
     """Numbers for the notebook prose, computed from analysis_n<n>.nc."""
     k0 = an.kernel.values[0]
-    out = {"kernel": float(k0), "piles": an.sizes["pile"], "n_grains": None}
+    out = {"kernel": float(k0), "piles": an.sizes["pile"]}
     for h in an.history.values:
         s = an.sel(history=h, kernel=k0)
         out[h] = dict(dip=float(s.dip_mean), lo=float(s.dip_lo), hi=float(s.dip_hi),
                       dips_by_kernel={float(k): float(an.dip_mean.sel(history=h, kernel=k)) for k in an.kernel.values},
                       frac_dip=float((an.dip.sel(history=h, kernel=k0) > 0).mean()),
+                      frac_by_kernel={float(k): float((an.dip.sel(history=h, kernel=k) > 0).mean())
+                                      for k in an.kernel.values},
                       center=float(s.profile_mean.sel(xi=0.0, method="nearest")),
                       L=float(an.base_half_width.sel(history=h).mean() / an.attrs["mean_diameter"]),
+                      fitL=float(an.fit_half_width.sel(history=h).mean() / an.attrs["mean_diameter"]),
                       slope=float(an.surface_angle.sel(history=h).mean()),
+                      apex=float(an.apex_height.sel(history=h).mean()),
+                      cone=float(an.cone_ratio.sel(history=h).mean()),
                       dev_median=float(an.cut_deviation.sel(history=h).median()),
                       dev_iqr=float(an.cut_deviation.sel(history=h).quantile(0.75)
                                     - an.cut_deviation.sel(history=h).quantile(0.25)),
