@@ -304,19 +304,24 @@ def wait_for(predicate, timeout, what):
 
 @pytest.mark.parametrize("how", ["SIGKILL snakemake", "SIGKILL group", "SIGTERM snakemake"])
 def test_an_interrupted_run_reruns_without_flags_and_gives_the_same_file(dag_repo, tmp_path, how):
-    """Kill Snakemake in the middle of an ensemble job (fig1 shard 0), then a plain rerun:
+    """Kill Snakemake in the middle of an ensemble job (fig1's first shard), then a plain rerun:
     no --unlock, no --rerun-incomplete; no half-written output at any time; the
     interrupted job is redone and the merged file equals the uninterrupted run's."""
     from ncd.pipeline import _snakemake_processes
 
     work = tmp_path / "work"
     target = "results/fig1_wedged/ensemble.nc"
-    shard_log = work / "results/logs/fig1_wedged/explore_ensemble_0-of-2.log"
+    logs = [work / f"results/logs/fig1_wedged/explore_ensemble_{k}-of-2.log" for k in (0, 1)]
+    shards = [work / f"results/fig1_wedged/shards/ensemble_{k}-of-2.nc" for k in (0, 1)]
     proc = start_snakemake(dag_repo, work, "-j1", target)
-    shard = work / "results/fig1_wedged/shards/ensemble_0-of-2.nc"
-    wait_for(lambda: shard_log.exists() and "rule fig1_wedged_explore" in shard_log.read_text(), 600,
-             "shard 0 to start")
-    assert not shard.exists()                       # its job runs (a shard takes seconds): kill now
+
+    def started():
+        return [k for k in (0, 1) if logs[k].exists() and "rule fig1_wedged_explore" in logs[k].read_text()]
+
+    wait_for(started, 600, "the first shard to start")
+    k = started()[0]                                # the job in flight (-j1: one at a time)
+    shard, other = shards[k], shards[1 - k]
+    assert not shard.exists()                       # it runs (a shard takes seconds): kill now
     if how == "SIGKILL group":                      # Snakemake and its jobs (a lost node, kill -9 of the session)
         os.killpg(proc.pid, signal.SIGKILL)
     else:                                           # Snakemake only: its job runs on, orphaned, or is cancelled
@@ -333,16 +338,17 @@ def test_an_interrupted_run_reruns_without_flags_and_gives_the_same_file(dag_rep
 
     if how == "SIGTERM snakemake":                  # Snakemake lets its running job finish, starts no other
         assert "Will exit after finishing currently running jobs" in console, console[-3000:]
-        assert shard.exists() and not (work / "results/fig1_wedged/shards/ensemble_1-of-2.nc").exists()
-    else:                                           # killed within shard 0's job
+        assert shard.exists() and not other.exists()
+    else:                                           # killed within the shard's job
         assert "Finished jobid" not in console, console[-3000:]
         assert shard.exists() == (how == "SIGKILL snakemake")       # its orphan finished it
         finished_by_orphan = shard.exists()
     rerun = run_snakemake(dag_repo, "-j1", target, workdir=work)
     out = rerun.stdout + rerun.stderr
-    redone = re.search(r"output: results/fig1_wedged/shards/ensemble_0-of-2.nc\n.*?reason: ([^\n]*)", out, re.S)
-    if how == "SIGTERM snakemake":                  # shard 0 was finished and recorded: kept
-        assert not redone and "ensemble_1-of-2.nc" in out, out[-3000:]
+    redone = re.search(rf"output: results/fig1_wedged/shards/ensemble_{k}-of-2.nc\n(?:[^\n]*\n){{0,6}}?"
+                       r"\s*reason: ([^\n]*)", out)
+    if how == "SIGTERM snakemake":                  # the finished shard was recorded: kept
+        assert not redone and f"ensemble_{1 - k}-of-2.nc" in out, out[-3000:]
     else:                                           # the interrupted job was redone: as incomplete when
         assert redone, out[-3000:]                  # its orphaned process finished the file, else as missing
         assert redone.group(1).startswith("Forced execution" if finished_by_orphan else "Missing output"), \
