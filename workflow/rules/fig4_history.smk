@@ -63,6 +63,7 @@ rule fig4_history_notebook:
         analysis=f"{FH}/analysis_n{NH}.nc",
         point=f"{FH}/piles/n{NH}/point_000.nc",
         rain=f"{FH}/piles/n{NH}/rain_000.nc",
+        plots=str(REL / "ncd" / "figures" / "history_plots.py"),
         notebook=notebook_file(FIGH),
         notebook_py=notebook_file(FIGH, "py"),
     output:
