@@ -72,3 +72,58 @@ def test_animation_has_every_frame(tmp_path):
 def test_no_frames_is_a_clear_error(tmp_path):
     with pytest.raises(ExportError, match="snapshot_every"):
         write_vtk(xr.Dataset({"pos_x": ("disc", np.zeros(2))}), tmp_path)
+
+
+def _construction(n_frames=3, n_discs=5):
+    """A construction file of Figure 4 with frames (ncd.figures.construction.add_frames):
+    grains poured one frame after another (NaN until poured), ground discs."""
+    from ncd.figures.construction import FRAME, add_frames
+
+    rng = np.random.default_rng(2)
+    fr = np.full((n_frames, len(FRAME), n_discs), np.nan)
+    for i in range(n_frames):
+        k = 2 + i  # grains poured so far
+        fr[i, :, :k] = rng.random((len(FRAME), k))
+        fr[i, FRAME.index("radius"), :k] = 0.01 + 0.001 * np.arange(k)
+    ds = xr.Dataset({"x": ("grain", fr[-1, 0]), "radius": ("grain", fr[-1, 2]),
+                     "ground_x": ("ground", [0.0, 0.02, 0.04]), "ground_y": ("ground", np.zeros(3)),
+                     "ground_radius": ("ground", np.full(3, 0.01))})
+    return add_frames(ds, (100 * np.arange(1, n_frames + 1), fr), 3e-4), fr
+
+
+def test_construction_frames_to_vtk(tmp_path):
+    ds, fr = _construction()
+    assert ds["frame_time"].values == pytest.approx([0.03, 0.06, 0.09])
+    assert all(ds[f"frame_{q}"].attrs["units"] for q in ("x", "vx", "spin"))
+    discs, ground = write_vtk(ds, tmp_path, "construction")
+    files = [e.attrib for e in ET.parse(discs).getroot().iter("DataSet")]
+    assert [float(f["timestep"]) for f in files] == pytest.approx([0.03, 0.06, 0.09])
+    for i in range(3):  # only the grains poured by frame i, with their frame's values
+        m = meshio.read(tmp_path / f"construction_discs_{i:04d}.vtu")
+        k = 2 + i
+        assert len(m.points) == k
+        np.testing.assert_allclose(m.points[:, 0], fr[i, 0, :k])
+        np.testing.assert_allclose(m.points[:, 1], fr[i, 1, :k])
+        np.testing.assert_allclose(m.point_data["radius"], fr[i, 2, :k])
+        np.testing.assert_allclose(m.point_data["velocity"][:, :2], fr[i, 3:5, :k].T)
+        np.testing.assert_allclose(m.point_data["spin"], fr[i, 5, :k])
+    g = meshio.read(ground)
+    np.testing.assert_allclose(g.points[:, 0], [0.0, 0.02, 0.04])
+    np.testing.assert_allclose(g.point_data["radius"], 0.01)
+
+
+def test_construction_animation_has_every_frame(tmp_path):
+    ds, _ = _construction(n_frames=4)
+    path = animate(ds, tmp_path / "pile.mp4", fps=5)
+    assert path.exists() and path.stat().st_size > 1000
+    if path.suffix == ".gif":
+        from PIL import Image
+
+        with Image.open(path) as im:
+            assert im.n_frames == 4
+    else:
+        import subprocess
+
+        out = subprocess.run(["ffprobe", "-v", "error", "-count_frames", "-select_streams", "v:0", "-show_entries",
+                              "stream=nb_read_frames", "-of", "csv=p=0", str(path)], capture_output=True, text=True)
+        assert out.stdout.strip() == "4"

@@ -34,6 +34,22 @@ RECORD = ("time", "n_grains", "kinetic_energy", "sweeps", "residual", "converged
 FRAME = ("x", "y", "radius", "vx", "vy", "spin")
 
 
+def add_frames(ds, frames, h):
+    """Add the frames ``(frame_steps, frames)`` of :func:`build` to ``ds`` as ``frame_<q>``
+    (``frame`` x ``disc``, q in :data:`FRAME`), ``frame_step`` and ``frame_time`` (read by
+    :mod:`ncd.export`); returns ``ds``."""
+    steps, fr = frames
+    units = {"x": "m", "y": "m", "radius": "m", "vx": "m s-1", "vy": "m s-1", "spin": "rad s-1"}
+    names = {"x": "centre x", "y": "centre y", "radius": "radius", "vx": "velocity x", "vy": "velocity y",
+             "spin": "angular velocity"}
+    for j, q in enumerate(FRAME):
+        ds[f"frame_{q}"] = (("frame", "disc"), fr[:, j, :],
+                            {"units": units[q], "long_name": f"grain {names[q]} in a stored frame (NaN: not yet poured)"})
+    ds["frame_step"] = ("frame", np.asarray(steps, np.int64), {"units": "1", "long_name": "construction step of the frame"})
+    ds["frame_time"] = ("frame", np.asarray(steps) * h, {"units": "s", "long_name": "time of the frame"})
+    return ds
+
+
 def _frame(scene, n_target):
     """The mobile grains' state, padded with NaN to ``n_target`` discs."""
     nm = scene.n_mobile

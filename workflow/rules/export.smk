@@ -1,13 +1,15 @@
 # ParaView and animation output (ncd/export.py): `snakemake -j2 export`, not part of the
 # default target.  For each figure whose data file stores frames (fig2_slope: the flow,
-# every `flow.snapshot_every` steps):
+# every `flow.snapshot_every` steps; fig4_pile: the pile's construction, every
+# `construction.frame_every` steps, with the ground discs in <name>_ground.vtu):
 #   results/<figure>/vtk/<name>_discs.pvd, <name>_contacts.pvd (+ one .vtu per frame)
 #   results/figures/<figure>.mp4  (animated .gif instead when ffmpeg is absent)
 import shutil
 
 ANIM_EXT = "mp4" if shutil.which("ffmpeg") else "gif"
 # figure: (data file with a `frame` dimension, name of the series)
-EXPORTS = {f: v for f, v in {"fig2_slope": ("results/fig2_slope/trajectory.nc", "flow")}.items()
+EXPORTS = {f: v for f, v in {"fig2_slope": ("results/fig2_slope/trajectory.nc", "flow"),
+                             "fig4_pile": ("results/fig4_pile/construction.nc", "construction")}.items()
            if f in FIGURES}
 
 

@@ -1,12 +1,17 @@
-"""Figure 4: pour the pile and settle it until the warm equilibrium test passes (construction.nc)."""
+"""Figure 4: pour the pile and settle it until the warm equilibrium test passes (construction.nc,
+with frames every `construction.frame_every` steps)."""
 from ncd.figures import pile
+from ncd.figures.construction import add_frames
 from ncd.io import write_dataset
 from ncd.pipeline import start
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)
 cfg = snakemake.params.config  # noqa: F821
-scene, record, ground, eq = pile.construct(cfg, log)
+frame_every = cfg["construction"]["frame_every"]
+scene, record, ground, eq, *frames = pile.construct(cfg, log, frame_every=frame_every)
 ds = pile.construction_dataset(cfg, scene, record, ground, eq)
+if frame_every > 0:  # frames for ParaView and the animation (ncd.export, `snakemake export`)
+    add_frames(ds, frames[0], cfg["h"])
 write_dataset(ds, snakemake.output[0])  # noqa: F821
 d = ds.attrs["mean_diameter"]
 log.info("%d grains, %d steps (t = %.3f s), %.1f ms/step, sweeps mean %.0f, %d steps not converged, "
