@@ -247,9 +247,9 @@ def test_an_ensemble_is_identical_with_its_attributes_whatever_the_shard_count(d
     run_snakemake(dag_repo, "-j2", *targets, extra_configs=[overlay], workdir=work)
     for target in targets:
         ref, new = xr.load_dataset(dag_repo / target), xr.load_dataset(work / target)
-        assert "shards" not in ref.attrs["config_yaml"] and ref.attrs == new.attrs, target
+        assert "shards" not in ref.attrs["config_yaml"], target
         timing = [v for v in ref.data_vars if "wall_time" in v]
-        xr.testing.assert_identical(ref.drop_vars(timing), new.drop_vars(timing))
+        xr.testing.assert_identical(ref.drop_vars(timing), new.drop_vars(timing))    # attributes included
 
 
 def test_a_failing_job_writes_its_traceback_to_its_log(tmp_path):
