@@ -412,67 +412,75 @@ Markdown(cs.census_text(census))
 # %% [markdown]
 # ## What we measured, and where the reproduction differs
 #
-# The numbers printed above are those of this run (the reduced test
-# configuration prints its own). With the default configuration (355 discs,
-# step 70, 1000 + 1000 runs, tolerances $10^{-3} \dots 10^{-8}$) we measured:
-#
-# * **The paper's dispersion is a true indeterminacy of the step problem.**
-#   The zero-guess spread of the chosen grain (grain 163, the largest) is
-#   1.12 m/s² ($0.11\,g$) at every tolerance from $10^{-5}$ to $10^{-8}$,
-#   while the warm-start spread falls tenfold per decade, from
-#   $1.8\times10^{-2}$ at $10^{-4}$ to $2.9\times10^{-5}$ m/s² at $10^{-8}$:
-#   the warm-start dispersion *is* iteration error, the zero-guess one is not
-#   (ratio $3.8\times10^{4}$ at $10^{-8}$). All 2000 runs reached $10^{-8}$:
-#   median 4410 sweeps (max 8590, about 0.1 s) from the zero guess, 3520
-#   (max 3970) from the warm start. At some other steps plain NLGS does not
-#   reach $10^{-8}$ within 30000 sweeps (the scan: no run at steps 10 and 30,
-#   no zero-guess run at step 100, one warm run of six at step 50); the flow
-#   itself stopped 4 of its steps at its 20000-sweep budget (tolerance
-#   $10^{-6}$). Such steps were not used.
-# * **NLGS reaches two end points; the step has more solutions.** The
-#   converged runs reach two distinct solutions (zero guess: 323 and 677 runs;
-#   warm start: all 1000 on the first, which is also the one the time stepping
-#   itself followed), so every grain's NLGS cloud is a segment: minor/major
-#   $6\times10^{-6}$ for the chosen grain, at most $1.2\times10^{-4}$ over the
-#   52 grains (15 %) with a visible dispersion. These two points are not the
-#   whole solution set: the census below (Lemke's method, status enumeration,
-#   random guesses) counts the exact solutions of the step from this run's data.
-# * **Loose tolerances draw the line too.** At $10^{-3}$ both ensembles are
-#   elongated clouds along nearly the same direction (major axis at $-12°$
-#   and $-9°$ against $-6.6°$ for the segment joining the two solutions;
-#   minor/major 0.13 and 0.27), and most grains show a visible dispersion
-#   (79 % and 69 %), the warm start included (spread 0.46 m/s² against 0.80).
-#   The paper's contrast — a line from the zero guess, almost
-#   nothing from the warm start — appears here from $10^{-4}$ on (1.11 against
-#   0.018 m/s²) and holds at convergence, where the line shrinks to its two
-#   end points.
-# * **Where the alternative is decided: a few contacts that stick in one
-#   solution and slide in the other.** The two solutions differ in the status
-#   of 5 of 548 contacts, all between neighbouring grains in one region above
-#   the ground: four switch between sticking and sliding, one between sliding
-#   and no contact. The difference spreads through the network of contacts
-#   that stick in both solutions (it joins most grains; the grains roll on
-#   each other, so the difference is not a rigid motion) and decays with the
-#   number of sticking links: median 0.84 m/s² within two links of a switching
-#   contact, 0.16 at three to five, 0.03 at twelve to fourteen. This supports
-#   Moreau's hint that the non-sliding contacts are determinant: they are
-#   where the choice is made (stick or slip), and they carry it to the grains
-#   around. The direction of a grain's NLGS line is that of the difference of
-#   the two solutions NLGS reaches at that grain.
-# * **Warm starts are not always determinate.** At the default step all
-#   warm-started runs agree, as the paper says. The scan shows that this is
-#   not a rule: at step 90 the warm-started runs reach two solutions while
-#   the zero-guess runs agree, at steps 20 and 60 both spread. Of the 8
-#   scanned steps where runs converged, 7 showed two solutions in one
-#   ensemble or the other (with only 6 runs each): in this early, dense phase
-#   of the flow, indeterminacy is the rule, not the exception.
-#   Which solution the time stepping follows is decided by the initial guess
-#   *and* the review order.
-# * **Differences from the paper.** The size distribution (ratio 2), the
-#   layer (30 d wide, about 10 d thick), the rough ground, the deposit, the
-#   time step and the investigated time (35 ms after the release, mean
-#   velocity 0.03 m/s, accelerating at 0.86 m/s²) are ours; the paper gives
-#   none of them. Its figure shows a line of many points; at convergence our
-#   NLGS runs reach two, and a filled line only for runs stopped at a loose tolerance, so
-#   the points *inside* the paper's line may well be runs stopped before
-#   convergence, while the line itself joins distinct solutions.
+# The text below is written from this run's data when the notebook runs (the paper's
+# values: $N = 355$ discs, slope 24°, friction 0.5).
+
+# %%
+loose = tols.max()
+window = tols[tols <= tight * 10.0 ** an["decades"]]
+zs = [float(sel.spread.sel(init="zero", tol=t)) for t in window]
+ws = {t: float(sel.spread.sel(init="warm", tol=t)) for t in tols}
+et = ens.sel(tol=tight)
+conv_t = {init: int(et.sel(init=init).converged.sum()) for init in ens.init.values}
+n_runs = {init: et.sel(init=init).sizes["run"] for init in ens.init.values}
+sw_med = {init: et.sel(init=init).sweeps.median().item() for init in ens.init.values}
+sw_max = {init: et.sel(init=init).sweeps.max().item() for init in ens.init.values}
+scan_text = ""
+if len(scan):
+    none = {init: int((traj[f"scan_{init}_converged"].values == 0).sum()) for init in ("zero", "warm")}
+    several = {init: traj[f"scan_{init}_solutions"].values > 1 for init in ("zero", "warm")}
+    n_scan = len(traj[f"scan_zero_solutions"])
+    scan_text = (f" In the scan of the flow ({n_scan} steps, {cfg['scan']['runs']} runs each), no zero-guess run "
+                 f"converged at {none['zero']} steps and no warm run at {none['warm']}; several solutions appear at "
+                 f"{int(several['zero'].sum())} steps from the zero guess and at {int(several['warm'].sum())} from "
+                 f"the warm start ({int((several['zero'] | several['warm']).sum())} of {n_scan} in one ensemble or "
+                 "the other)" + (": the warm start is not always determinate, and which solution the time stepping "
+                                 "follows is decided by the initial guess *and* the review order." if several["warm"].any()
+                                 else "; the warm start reached one solution at every scanned step."))
+sol_text = ", ".join(f"{init}: {counts.sel(init=init).values[counts.sel(init=init).values > 0].tolist()} runs"
+                     for init in meas.init.values)
+vis_text = (f"{int(vis.sum())} grains ({float(vis.mean()):.0%}) have a visible zero-guess dispersion, with "
+            f"minor/major ratios up to {ratios.max():.1e}" if vis.any() else "no grain has a visible dispersion")
+switch_text = ""
+if "switched" in meas and len(sw):
+    from collections import Counter
+    moves = Counter(f"{status_names[int(st[runs[0], c])]} → {status_names[int(st[runs[1], c])]}" for c in sw)
+    near_med = [(lo, hi, np.median(dmag[(dist >= lo) & (dist <= hi)])) for lo, hi in bins
+                if lo >= 0 and ((dist >= lo) & (dist <= hi)).any()]
+    switch_text = (
+        f"The two most frequent solutions differ in the status of {len(sw)} of {ens.sizes['contact']} contacts ("
+        + ", ".join(f"{n} {m}" for m, n in moves.items()) + "). The difference spreads through the network of "
+        f"contacts that stick in both (it joins {int(meas.cluster_size.max())} of {len(dmag)} grains; not a rigid "
+        f"motion: relative residual of the best rigid fit {np.median(rigid_res[big]):.2f}) and its median size "
+        "goes " + ", ".join(f"{m:.2g} m/s² at {lo}–{hi}" for lo, hi, m in near_med[:1] + near_med[1:2] + near_med[-1:])
+        + " sticking links from a switching contact. This supports Moreau's hint that the non-sliding contacts "
+        "are determinant: they are where the choice (stick or slip) is made, and they carry it to the grains around.")
+zero_l, warm_l = sel.sel(init="zero", tol=loose), sel.sel(init="warm", tol=loose)
+seg_angle = (f" against {np.degrees(np.arctan2(u[1], u[0])):.1f}° for the segment joining the two solutions"
+             if meas.attrs["n_solutions"] >= 2 else "")
+Markdown(f"""
+* **Dispersion against tolerance: {verdict}.** The zero-guess spread of the chosen grain (grain {grain}) lies
+  in {min(zs):.3g}–{max(zs):.3g} m/s² ({min(zs) / g:.2f}–{max(zs) / g:.2f} $g$) at every tolerance from
+  {window.max():.0e} to {tight:.0e}, while the warm-start spread goes from {ws[sorted(tols)[-2]]:.2g} m/s² at
+  {sorted(tols)[-2]:.0e} to {ws[tight]:.2g} m/s² at {tight:.0e} (zero/warm {meas.attrs['verdict_zero_over_warm']:.3g}).
+  Converged at {tight:.0e}: {', '.join(f'{i} {conv_t[i]}/{n_runs[i]}' for i in conv_t)}; median sweeps
+  {', '.join(f'{i} {sw_med[i]:.0f} (max {sw_max[i]:.0f})' for i in sw_med)}. The flow itself stopped
+  {int((traj.converged == 0).sum())} of its {traj.sizes['step']} steps at its {fl['solver']['max_sweeps']}-sweep
+  budget (tolerance {fl['solver']['tol']:g}).{scan_text}
+* **NLGS end points.** At {tight:.0e} the converged runs reach {meas.attrs['n_solutions']} distinct solution(s)
+  ({sol_text}); the chosen grain's cloud has minor/major {float(sel.ratio.sel(init='zero', tol=tight)):.1e}, and
+  {vis_text}. The census above counts the exact solutions of the step.
+* **Loose tolerances.** At {loose:.0e} the chosen grain's major axes lie at {float(zero_l.angle):.0f}° (zero
+  guess) and {float(warm_l.angle):.0f}° (warm start){seg_angle}; minor/major {float(zero_l.ratio):.2g} and
+  {float(warm_l.ratio):.2g}; spreads {float(zero_l.spread):.2g} and {float(warm_l.spread):.2g} m/s²; visible
+  dispersion in {float(meas.visible_fraction.sel(init='zero', tol=loose)):.0%} and
+  {float(meas.visible_fraction.sel(init='warm', tol=loose)):.0%} of the grains.
+* **Where the alternative is decided.** {switch_text or 'No pair of solutions to compare at this step.'}
+* **Differences from the paper.** The size distribution (ratio {sc['size_ratio']}), the layer
+  ({sc['width_diameters']} d wide), the rough ground, the deposit, the time step and the investigated step
+  ({float(traj.attrs['investigated_time']) * 1e3:.0f} ms after the release, mean velocity
+  {float(traj.mean_vx[k_step - 1]):.2g} m/s, accelerating at {slope_fit:.2g} m/s²) are ours; the paper gives none of
+  them. Its figure shows a line of many points; at convergence our NLGS runs reach a few end points, and a
+  filled line only for runs stopped at a loose tolerance, so the points *inside* the paper's line may be runs
+  stopped before convergence, while the line itself joins distinct solutions.
+""")

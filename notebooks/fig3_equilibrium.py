@@ -117,9 +117,10 @@ for m, ds in subsets.items():
 # %%
 conv = ens.isel(run=np.nonzero(ens.converged.values == 1)[0])
 rho = np.stack([conv.force_n.values, conv.force_t.values], -1).reshape(conv.sizes["run"], -1)
-eq_res, coulomb = P.violations(rho)
-outside = max(outside_distance(np.column_stack([conv.force_n.values[:, k], conv.force_t.values[:, k]]),
-                               fe.polygon(proj, k)).max() for k in range(kappa))
+eq_res, coulomb = P.violations(rho) if len(rho) else (np.full(1, np.nan), np.full(1, np.nan))
+outside = max((outside_distance(np.column_stack([conv.force_n.values[:, k], conv.force_t.values[:, k]]),
+                                fe.polygon(proj, k)).max() for k in range(kappa)), default=np.nan) \
+    if conv.sizes["run"] else np.nan
 print(f"converged runs: max equilibrium residual {eq_res.max():.1e}, max Coulomb violation {coulomb.max():.1e} "
       f"(relative to the largest weight {P.scale:.3g} N); farthest point outside its exact polygon "
       f"{outside / P.scale:.1e} weights")
@@ -274,41 +275,51 @@ plt.show()
 # %% [markdown]
 # ## What we measured, and where the reproduction differs
 #
-# The numbers are printed above from the data; the statements below describe the
-# default configuration (`config.yaml`: 10 000 + 10 000 + 1 000 runs, 20 000
-# uniform points), and those that are claims of the issue are checked by
-# `tests/test_fig3_equilibrium.py`.
-#
-# * **$A \cap C$ exactly.** The deposited packing has $\kappa = 45$ contacts
-#   (9 with walls) for $N = 28$ discs: $2\kappa - 3N = 6$, but one disc touches
-#   only the floor, so its horizontal-force and moment equations both say
-#   $r_t = 0$; hence $\dim A = 2\kappa - \operatorname{rank} H = 7$, and
-#   $A \cap C$ has the same dimension (no Coulomb condition is tight at every
-#   equilibrium). It is bounded. Of its 45 projections one is a point (a force
-#   fixed by statics), 25 are segments and 19 are polygons; every one is exact
-#   (the inner hull of the support points and the outer intersection of the
-#   supporting half-planes coincide to $10^{-8}$ of the largest area).
-# * **Every converged run lies in $A \cap C$.** All runs converge (natural-map
-#   residual $\le 10^{-8}$; about 2 200 sweeps from a zero or random guess, a
-#   few milliseconds each, one sweep from the warm guess). The points satisfy
-#   equilibrium to about $10^{-6}$ of the largest weight, Coulomb's law
-#   exactly, and lie inside their exact polygons to $10^{-5}$ weights. NLGS
-#   converges linearly here (left panel of the convergence plot, no stagnation
-#   before $10^{-8}$), so the spread of the clouds is indeterminacy of the
-#   equilibrium forces, not unfinished iterations.
-# * **Zero guess with random orders (the paper's figure) explores little.** Its
-#   clouds are short streaks covering about 1 % of the exact projection of each
-#   displayed contact: the $(\kappa - 1)!$ review orders reach limits close to
-#   each other. Moreau's statement that this exploration generates "a
-#   significant outline of the solution set" does not hold for this packing; the
-#   exact polygons show how much it misses.
-# * **Random initial guesses** (section 2's other exploration; normal impulses
-#   uniform in $[0, \max s_n^{\text{rest}}]$, tangential ones uniform in the
-#   sector, fixed review order) cover most of each polygon (the coverage
-#   table above gives the measured fractions), at the same cost per run.
-# * **Warm start** (the impulses of the last deposition step): every run stops
-#   after one sweep at one point (spread $\sim 10^{-12}$ N), the "very little
-#   indeterminacy" of section 2. That point is interior to $A \cap C$.
+# The text below is written from this run's data when the notebook runs; the claims
+# of the issue are checked by `tests/test_fig3_equilibrium.py`.
+
+# %%
+pa = proj.attrs
+n_conv = {m: int(ds.converged.sum()) for m, ds in subsets.items()}
+cov = {m: [r["coverage"] for r in rows if r["mode"] == m] for m in modes}
+extra = int(pa["dimension_A"]) - int(pa["dimension_moreau"])
+why = (f"but rank $H$ = {3 * N - extra} < $3N$ (a disc whose equations are dependent, e.g. one resting on the "
+       "floor only, whose horizontal-force and moment equations both say $r_t = 0$); hence " if extra > 0 else "and ")
+tight = int(pa["dimension_AC"]) < int(pa["dimension_A"])
+Markdown(f"""
+* **$A \\cap C$ exactly.** The deposited packing has $\\kappa$ = {kappa} contacts ({state.attrs['n_wall_contacts']}
+  with walls) for $N$ = {N} discs: $2\\kappa - 3N$ = {pa['dimension_moreau']}, {why}$\\dim A = 2\\kappa -
+  \\operatorname{{rank}} H$ = {pa['dimension_A']}, and $\\dim A \\cap C$ = {pa['dimension_AC']}
+  ({'some Coulomb condition is tight at every equilibrium' if tight else 'no Coulomb condition is tight at every equilibrium'}).
+  It is {'bounded' if pa['bounded'] else 'unbounded'}. Its {kappa} projections are {int((nv == 1).sum())} point(s)
+  (forces fixed by statics), {int((nv == 2).sum())} segment(s) and {int((nv >= 3).sum())} polygon(s);
+  {'every one is exact' if bool(proj.exact.all()) else f'{int((~proj.exact.values.astype(bool)).sum())} are not exact'}
+  (inner hull of the support points and outer intersection of the supporting half-planes agree to
+  {np.nanmax((proj.outer_area - proj.area).values) / np.nanmax(proj.area.values):.0e} of the largest area).
+* **Every converged run lies in $A \\cap C$.** Converged runs (natural-map residual
+  $\\le$ {ens.attrs['solver_tol']:g}): {', '.join(f'{m} {n_conv[m]}/{subsets[m].sizes["run"]}' for m in modes)};
+  median sweeps {', '.join(f'{m} {np.median(subsets[m].sweeps.values):.0f}' for m in modes)}. The converged points
+  satisfy equilibrium to {np.max(eq_res):.0e} and Coulomb's law to {np.max(coulomb):.0e} of the largest weight,
+  and lie within {outside / P.scale:.0e} weights of their exact polygons. NLGS converges linearly here (left
+  panel of the convergence plot), so the spread of the clouds is indeterminacy of the equilibrium forces, not
+  unfinished iterations.
+* **Zero guess with random orders (the paper's figure).** Its clouds cover
+  {', '.join(f'{c:.1%}' for c in cov['zero'])} of the exact projections of the displayed contacts
+  ({', '.join(str(k) for k in shown)}): the $(\\kappa - 1)!$ review orders reach limits close to each other.
+  {'Moreau' + chr(39) + 's statement that this exploration generates "a significant outline of the solution set" '
+   'does not hold for this packing; the exact polygons show how much it misses.' if max(cov['zero']) < 0.5 else
+   'This outlines a large part of the solution set, as Moreau says.'}
+* **Random initial guesses** (section 2's other exploration; normal impulses uniform in
+  $[0, \\max s_n^{{\\text{{rest}}}}]$, tangential ones uniform in the sector, fixed review order) cover
+  {', '.join(f'{c:.1%}' for c in cov['random'])} of the same polygons, at a median cost of
+  {1e3 * np.median(subsets['random'].wall_time.values):.1f} ms per run
+  (zero guess: {1e3 * np.median(subsets['zero'].wall_time.values):.1f} ms).
+* **Warm start** (the impulses of the last deposition step): median {np.median(subsets['warm'].sweeps.values):.0f}
+  sweeps, spread {', '.join(f'{r["spread"]:.0e}' for r in rows if r['mode'] == 'warm')} N on the displayed
+  contacts: the "very little indeterminacy" of section 2.
+""")
+
+# %% [markdown]
 # * **Ghost images.** Measured over every run (next cell): where the NLGS
 #   solutions lie among the faces of $A \cap C$, which contacts carry no force
 #   and which slide at the Coulomb limit. A uniform point is interior with

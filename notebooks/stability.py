@@ -220,50 +220,82 @@ display(Markdown("\n".join(lines)))
 # $h\omega \le 2(\sqrt{1+\zeta^2}-\zeta)$, i.e. $0.83/\omega$ for $e = 0$ ($\zeta = 1$);
 # and a disc with $z$ springs (the light disc of the stack, the hexagonal packing,
 # the tangential springs acting on the spin, $1/m + r^2/I = 3/m$) has a larger
-# $\omega$.  So MD needs $h$ a fraction (0.05–0.5 here, see the verdicts) of $2/\omega$; above it the
+# $\omega$.  So MD needs $h$ a fraction (per case in the verdicts) of $2/\omega$; above it the
 # energy grows by orders of magnitude within a few steps (panels a, c, d), as the
 # paper implies.  With $k_n$ set by the heavy disc of the $10^6$ stack the light
 # disc's $\omega$ is $10^3$ times larger than the heavy one's: MD pays this stiffness
 # with $\sim 10^5$–$10^6$ steps.
 #
-# **CD is bounded at every $h$ tried** (up to $10^3$–$10^5\,h_\mathrm{crit}$): the
-# implicit contact law never injects energy (growth $\le 10^{-14}E_s$ for $e<1$; the
-# $e = 1$ cradle keeps its energy to $10^{-7}$).  **Where CD is not accurate, and why:**
+# **CD** (verdicts above, measured values in the next cell): the implicit contact law
+# does not inject energy for $e < 1$, and the $e = 1$ cradle keeps its energy (panel d).
+# **Where CD is not accurate, and why:**
 #
 # 1. *Mass ratio $10^6$: NLGS does not converge.*  For the two contacts of the stack the
 #    Gauss–Seidel iteration contracts by $m_\mathrm{heavy}/(m_\mathrm{light}+m_\mathrm{heavy})
-#    = 1 - 10^{-6}$ per sweep, so no sweep budget reaches the tolerance: every step
-#    stops at `max_sweeps` with a residual $\sim 10^{-4}$, the impulses are too small
-#    and the heavy disc sinks into the light one (a sizeable fraction of a radius at
-#    $h = 10^{-3}$, a whole diameter at $h = 10^{-2}$).  At $1:10^3$ the contraction is
+#    = 1 - 10^{-6}$ per sweep, so no sweep budget reaches the tolerance: steps
+#    stop at `max_sweeps`, the impulses are too small
+#    and the heavy disc sinks into the light one.  At $1:10^3$ the contraction is
 #    $1 - 10^{-3}$ and the warm start keeps up.  MD, at its tiny step, is accurate here.
 # 2. *Large $h$: interpenetration $\approx v h$.*  CD does not correct positions: a
 #    contact becomes active only once its gap at the middle configuration is closed,
-#    so an approaching disc penetrates by up to its displacement per step (box at
-#    $h = 10^{-2}$: half a radius; 100 m/s impacts: $0.05\,r$ at $h = 10^{-5}$,
-#    $0.5\,r$ at $10^{-4}$).  When a disc moves more than a diameter per step it
-#    **tunnels through another disc** (impact at $h = 10^{-3}$: 10 radii per step, no
+#    so an approaching disc penetrates by up to its displacement per step.  When a
+#    disc moves more than a diameter per step it **tunnels through another disc** (no
 #    contact is ever detected).  A half-plane wall is never crossed unseen (its gap
 #    stays negative behind it), but the disc ends up beyond the wall line.
 # 3. *Very large $h$ on a packing at rest: active-set flicker.*  With the default slack
 #    ($10^{-9}r$) a contact whose gap opens by the NLGS residual velocity times $h/2$
 #    (here $\sim 10^{-8}\,g h \cdot h$) leaves the active set for a whole step and its
-#    disc falls freely by $g h^2$: at $h = 0.1$ s, 10 radii — the packing collapses
-#    through itself although every step "converged".  A tighter tolerance or an alert
-#    distance (case `hexagonal_alert`, slack $10^{-4} r$) removes it: the packing then
-#    stays at rest to $10^{-4} r$ even at $h = 1$ s.  Very small $h$ ($10^{-6}$ s) is
-#    harmless.
+#    disc falls freely by $g h^2$ — the packing can collapse through itself although
+#    every step "converged".  A tighter tolerance or an alert distance (case
+#    `hexagonal_alert`, larger slack) removes it.
 # 4. *$\mu = 10$: NLGS may cycle.*  On some steps the iterates of the falling box
-#    settle into a cycle (one contact flips between sliding and open) and the residual
-#    stalls near $10^{-1}$ whatever the sweep budget, review order or initial guess; the
-#    motion stays bounded and dissipative, but those steps are not solutions.
+#    can settle into a cycle (one contact flips between sliding and open) and the residual
+#    stall whatever the sweep budget, review order or initial guess; the motion stays
+#    bounded and dissipative, but those steps are not solutions.
 # 5. *$e = 1$ chain: energy kept, but not Newton's cradle.*  Moreau's impact law on the
 #    weighted mean $(U_f + eU_i)/(1+e)$ treats the touching chain as one simultaneous
 #    multi-contact collision: energy is conserved, yet the striker's momentum is shared
-#    (the last disc leaves at 0.4 of the striker's speed, the striker bounces back)
+#    (the last disc leaves at a fraction of the striker's speed, the striker bounces back)
 #    instead of passing through the chain as a sequence of binary collisions.  The
 #    Every step of this case converges in a few sweeps.  An earlier version flagged its
 #    steps after the impact as unconverged: the projection on the Coulomb cone returned
 #    $(z_n < 0, 0)$ unchanged when $\mu = 0$, so a separating frictionless contact with
 #    zero impulse read as unsolved (fixed in `ncd.local_solver.project_cone`, checked by
 #    `tests/test_mechanics.py`).
+
+# %%
+# the numbers of the five points above, from this run's table
+def case_rows(case, method="CD"):
+    return df[(df.case == case) & (df.method == method)] if case in cases else df.iloc[:0]
+
+
+pts = []
+s6 = case_rows("stack_1e6")
+if len(s6):
+    pts.append(f"1. `stack_1e6`: {int(s6.unconverged_steps.sum())} CD steps stopped at `max_sweeps` (largest residual "
+               f"{s6.residual_max.max():.1e}); interpenetration / r " + ", ".join(
+                   f"{p:.2g} at h = {h:.0e}" for h, p in zip(s6.h, s6.max_penetration)) + ".")
+imp = pd.concat([case_rows(c) for c in ("impact_wall", "impact_disc")] + [case_rows("mu0")])
+if len(imp):
+    tun = imp[imp.tunnelled == 1]
+    pts.append("2. Interpenetration / r: " + "; ".join(
+        f"`{c}` " + ", ".join(f"{p:.2g} at h = {h:.0e}" for h, p in zip(g.h, g.max_penetration))
+        for c, g in imp.groupby("case", sort=False)) + (
+        "; tunnelling at " + ", ".join(f"`{c}` h = {h:.0e}" for c, h in zip(tun.case, tun.h)) if len(tun) else
+        "; no tunnelling") + ".")
+hx, ha = case_rows("hexagonal"), case_rows("hexagonal_alert")
+if len(hx):
+    pts.append("3. `hexagonal` (displacement / r): " + ", ".join(f"{o:.2g} at h = {h:.0e}" for h, o in
+                                                               zip(hx.h, hx.observable))
+               + (f"; `hexagonal_alert`: at most {ha.observable.max():.1g} (largest h = {ha.h.max():g} s)"
+                  if len(ha) else "") + ".")
+m10 = case_rows("mu10")
+if len(m10):
+    pts.append(f"4. `mu10`: {int(m10.unconverged_steps.sum())} CD steps not converged, largest final residual "
+               f"{m10.residual_max.max():.1e} (tolerance {ds.attrs['solver_tol']:g})"
+               + ("." if m10.unconverged_steps.sum() else ": no cycling in this run."))
+ch = case_rows("e1_chain")
+if len(ch):
+    pts.append(f"5. `e1_chain` (CD): energy drift at most {ch.energy_drift.abs().max():.1g} E_s; the last disc leaves "
+               f"at {ch.observable.min():.2g}–{ch.observable.max():.2g} of the striker's speed (1 for Newton's cradle).")
+display(Markdown("**Measured in this run.**\n\n" + "\n".join(pts)))
