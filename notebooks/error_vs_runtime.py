@@ -263,19 +263,30 @@ display(Markdown("\n".join(lines)))
 # per decade (linear convergence of Gauss–Seidel), and the natural-map residual tracks
 # the distance to the limit within a factor of a few, so it is a usable stopping
 # criterion; the impulse-change criterion stops at about the same place.  The warm
-# start pays off on the packing and the pile (states at rest whose previous impulses
-# nearly solve the next step: up to 3 times fewer sweeps) and hardly or not at all on
-# the slope step, where the previous step's impulses include collisions that the next
-# step does not have.  The distance between the zero- and warm-started limits is the
-# paper's indeterminacy made visible: in a static packing the impulses of the two limits
-# differ by tens of percent while the velocities agree to rounding (the set of
-# equilibrium forces is a polytope, section 4); on the flowing slope step both limits
-# coincide in this configuration.
+# start can pay off on states at rest, whose previous impulses nearly solve the next
+# step, and less on the slope step, where the previous step's impulses include
+# collisions that the next step does not have (sweep ratios below).  The distance
+# between the zero- and warm-started limits is the paper's indeterminacy made visible:
+# where the impulses of the two limits differ while the velocities agree to rounding, the
+# step has several solutions with the same motion (the set of equilibrium forces is a
+# polytope, section 4); the measured distances are below.
 #
 # *Time integration.*  On the incline CD's error is at rounding level at any step: CD
 # pays nothing for precision there, while MD has to resolve the contact stiffness.  On
 # the heap and on the flow, each method's accuracy is limited by what the observable
 # can resolve: undamped residual motion for the ground reaction, the deposition protocol
 # for the packing fraction, chaos for the mean velocity.  MD needs $h$ a small fraction
-# of $2/\omega$ (0.1–0.3 here, see the `stability` notebook) and its stiff runs cost
+# of $2/\omega$ (see the `stability` notebook) and its stiff runs cost
 # proportionally to $\sqrt{k}$; CD's cost is set by the NLGS sweeps per step.
+
+# %%
+# the numbers behind the NLGS paragraph, from this run's data
+def _tight_sweeps(state, init):
+    return float(nl.sweeps.sel(state=state, init=init, criterion="residual").max())
+
+
+Markdown("**Measured in this run** (tightest setting, residual criterion; limits at the reference tolerance): "
+         + "; ".join(f"{st}: sweeps zero / warm start {_tight_sweeps(st, 'zero'):.0f} / {_tight_sweeps(st, 'warm'):.0f} "
+                     f"(ratio {_tight_sweeps(st, 'zero') / max(_tight_sweeps(st, 'warm'), 1):.2g}), zero- vs warm-started "
+                     f"limits: impulses {float(nl.limits_distance_impulse.sel(state=st)):.1e} (relative), velocities "
+                     f"{float(nl.limits_distance_velocity.sel(state=st)):.1e} g h" for st in nl.state.values) + ".")
