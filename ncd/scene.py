@@ -31,7 +31,7 @@ def make_scene(pos, radius, density=1.0, *, obstacle_pos=None, obstacle_radius=N
     e_n_obstacle = e_n if e_n_obstacle is None else checks.real("e_n_obstacle", e_n_obstacle, 0.0, 1.0)
     e_t_obstacle = e_t if e_t_obstacle is None else checks.real("e_t_obstacle", e_t_obstacle, 0.0, 1.0)
     gravity = checks.array("gravity", gravity, (2,))
-    checks.real("overlap_tolerance", overlap_tolerance, 0.0)
+    checks.real("overlap_tolerance", overlap_tolerance, 0.0, allow_inf=True)   # inf: no overlap check
 
     opos = np.zeros((0, 2)) if obstacle_pos is None else checks.array("obstacle_pos", obstacle_pos, (None, 2))
     if len(opos) and obstacle_radius is None:

@@ -356,3 +356,16 @@ def test_mass_ratio_1e12_and_tiny_discs():
         ncd.make_scene([[0.0, 0.5]], 1e-200, 1.0)
     with pytest.raises(ncd.InputError, match=r"disc 0: mass inf"):
         ncd.make_scene([[0.0, 0.5]], 1e200, 1e200)
+
+
+def test_overlap_tolerance_inf_skips_the_overlap_check():
+    """``overlap_tolerance = inf`` (the peer side by side rebuilds scenes mid-run) is no check,
+    while NaN and negative values are refused."""
+    pos = [[0.0, 0.0], [0.1, 0.0]]                    # overlap of half a radius
+    scene = ncd.make_scene(pos, 0.1, 1.0, overlap_tolerance=np.inf)
+    assert scene.n_disc == 2
+    with pytest.raises(ncd.InputError, match="overlap between disc 0 and disc 1"):
+        ncd.make_scene(pos, 0.1, 1.0, overlap_tolerance=0.5)
+    for bad in (np.nan, -1.0):
+        with pytest.raises(ncd.InputError, match="overlap_tolerance"):
+            ncd.make_scene(pos, 0.1, 1.0, overlap_tolerance=bad)

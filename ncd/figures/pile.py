@@ -10,14 +10,13 @@ resultants, ground pressure) are kept per run, with the run's outcome
 (:func:`ncd.convergence.classify`: converged at rest, converged in motion, or not;
 the observable is the default cut resultant and the binned ground pressure).
 """
-import time
 
 import numpy as np
 import scipy.sparse as sp
 import xarray as xr
 
 import ncd
-from ncd.explore import member_rng
+from ncd.explore import explore, member_rng
 from ncd.io import provenance
 from ncd.model import SimulationError
 from ncd.pipeline import settings as solver_settings
@@ -213,32 +212,6 @@ def _observable(cfg, scene, contacts, C, edges):
     return observe
 
 
-def _classified_runs(scene, problem, members, root_seed, settings, observe, h, progress=None):
-    """Zero-guess runs with the random review order of each member (as
-    :func:`ncd.explore.explore`), observed and classified (:mod:`ncd.convergence`)."""
-    from ncd.convergence import classify, max_speed
-    from ncd.explore import run_parallel
-    n, nm, nr = problem.contacts.n, scene.n_mobile, len(members)
-    out = {"impulse": np.zeros((nr, n, 2)), "vel": np.zeros((nr, nm, 2)), "spin": np.zeros((nr, nm)),
-           **{k: np.zeros(nr) for k in ("sweeps", "residual", "change", "converged", "wall_time", "outcome",
-                                        "max_speed", "observable_change", "finish_rounds")}}
-
-    def run(k):
-        order = member_rng(members[k], root_seed).permutation(n)
-        t0 = time.perf_counter()
-        result, vel, spin = ncd.solve_problem(scene, problem, None, order, settings, observe=observe)
-        out["wall_time"][k] = time.perf_counter() - t0
-        out["impulse"][k], out["vel"][k], out["spin"][k] = result.impulse, vel[:nm], spin[:nm]
-        for key in ("sweeps", "residual", "change", "converged", "observable_change", "finish_rounds"):
-            out[key][k] = getattr(result, key)
-        out["outcome"][k] = classify(result, vel, spin, scene, h)
-        out["max_speed"][k] = max_speed(vel, spin, scene, h)
-
-    run_parallel(run, nr, progress=progress)
-    out["converged"] = out["converged"].astype(bool)
-    return out
-
-
 def ensemble_shard(cfg, construction, cuts, members, tolerances, root_seed, log=None):
     """NLGS runs from the zero guess with random review orders on the final state
     (section 5), one set per tolerance; per run the cut resultants, the ground force
@@ -266,7 +239,7 @@ def ensemble_shard(cfg, construction, cuts, members, tolerances, root_seed, log=
                                       finish=e.get("finish", "none"), finish_tol=e.get("finish_tol", 1e-10),
                                       observable_tol=e.get("observable_tol", 1e-6))
         prog = Progress(log, len(members), f"tol {tol:g}") if log is not None else None
-        out = _classified_runs(scene, problem, members, root_seed, settings, observe, h, prog)
+        out = explore(scene, problem, members, root_seed, settings=settings, progress=prog, observe=observe)
         s = out["impulse"].reshape(len(members), -1)
         F = (C @ s.T).T / h
         res["cut_force_x"][:, j], res["cut_force_y"][:, j] = F[:, 0::2], F[:, 1::2]
