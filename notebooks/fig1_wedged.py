@@ -48,7 +48,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
 import yaml
-from IPython.display import Image, display
+from IPython.display import Image, Markdown, display
 
 from ncd.figures.wedged import Wedge
 
@@ -369,25 +369,41 @@ print(f"wall time per run: median {np.median(wt) * 1e6:.0f} us, max {wt.max() * 
 # %% [markdown]
 # ## What we measured, and where the reproduction differs
 #
-# * **The threshold.**  Wedged outcomes appear only for $\gamma > \beta$, as derived: the
-#   sweep (panel f) is zero at every angle below $\beta$ and positive at the first angle above.
-#   How fast the fraction rises above $\beta$ is *not* a property of the mechanics but of the
-#   guess distribution: near the threshold $N_{\min}\propto 1/\sin(\gamma-\beta)$ diverges
-#   and only guesses of comparable intensity end wedged: the apparent onset is where
-#   $N_{\min}(\gamma)$ falls below the largest guessed forces (`force_max` weights), i.e.
-#   $\sin(\gamma-\beta) \gtrsim \cos\gamma / (2\,$`force_max`$)$, about 0.3° above $\beta$
-#   for `force_max` = 100 — well inside the sweep's resolution.
-# * **The segment.**  Every converged wedged run satisfies equilibrium and Coulomb's law to
-#   the solver tolerance (force balance within about $10^{-10}\,mg$), and its $I$ lies on
-#   the closed-form segment and on the curve $y_I(N)$ (panels b, c).
-#   The top end ($N = N_{\min}$, both contacts at the edge of their cones) is approached
-#   closely; the bottom end $R\sin\beta$ only as $N$ grows without bound, as the closed form
-#   says.  The density of dots along the segment reflects our guess distribution, not a
-#   property of the solution set (the paper shows no distribution).
-# * **Zero guess vs history.**  All zero-guess runs fall, and evolution (a) is free fall to
-#   round-off; evolution (b), started from a wedged force state and warm-started, keeps $B$ at
-#   rest with constant forces for the whole run (one NLGS sweep per step): the forces act as
-#   state variables, as section 2 proposes.
+# The first three points are written from this run's data when the notebook runs.
+
+# %%
+fmax = cfg["ensemble"]["force_max"]
+onset = np.degrees(np.arcsin(np.cos(wedge.beta) / (2 * fmax)))   # sin(gamma - beta) = cos(gamma) / (2 force_max) at gamma ~ beta
+step_deg = float(np.diff(gam).min()) if len(gam) > 1 else np.nan
+zero_conv = conv & zero
+warm = evo.sel(evolution="wedged_warm")
+threshold = ("zero at every angle below $\\beta$" if not below.any() or np.nanmax(frac[below]) == 0
+             else f"up to {np.nanmax(frac[below]):.2g} below $\\beta$ (against the closed form)")
+first = (f"{frac[above][0]:.2g} at the first angle above ({gam[above][0]:.3g}°)" if above.any() else "no angle above")
+segment = (f"satisfies equilibrium to {eq:.0e} $mg$ and Coulomb's law to |T|/(μN) ≤ {np.abs(Ft / Fn).max() / wedge.mu:.6f}, "
+           f"and its $I$ lies within {np.abs(Iy - wedge.y_of_n(N)).max() / R:.0e} R of the curve $y_I(N)$ (panels b, c); "
+           f"the dots span {100 * (Iy.max() - Iy.min()) / (y_top - y_bot):.0f} % of the closed-form segment" if wed.any()
+           else "— none converged wedged in this run")
+Markdown(f"""
+* **The threshold.**  The closed form allows wedged states only for $\\gamma > \\beta$ = {np.degrees(wedge.beta):g}°
+  (config); the sweep (panel f) is {threshold} and {first}. How fast the fraction rises above $\\beta$ is *not* a
+  property of the mechanics but of the guess distribution: near the threshold $N_{{\\min}}\\propto 1/\\sin(\\gamma-\\beta)$
+  diverges and only guesses of comparable intensity end wedged: the apparent onset is where $N_{{\\min}}(\\gamma)$
+  falls below the largest guessed forces (`force_max` = {fmax:g} weights, config), i.e.
+  $\\sin(\\gamma-\\beta) \\gtrsim \\cos\\gamma / (2\\,$`force_max`$)$, about {onset:.2g}° above $\\beta$, against a
+  sweep step of {step_deg:.2g}°.
+* **The segment.**  Every converged wedged run ({int(wed.sum())} runs) {segment}. The top end ($N = N_{{\\min}}$,
+  both contacts at the edge of their cones) is approached closely; the bottom end $R\\sin\\beta$ only as $N$ grows
+  without bound, as the closed form says. The density of dots along the segment reflects our guess distribution,
+  not a property of the solution set (the paper shows no distribution).
+* **Zero guess vs history.**  Of the {int(zero_conv.sum())} converged zero-guess runs, {int((outcome[zero_conv] == 0).sum())}
+  fall; evolution (a) ends at y = {float(evo.sel(evolution='zero_guess').y.values[-1]):.6g} m against free fall
+  {-0.5 * wedge.g * t[-1] ** 2:.6g} m. Evolution (b), started from a wedged force state and warm-started, keeps $B$
+  within {np.abs(warm.y.values).max():.1e} m of rest over {t[-1]:g} s (at most {int(warm.sweeps.values[1:].max())}
+  NLGS sweeps per step after the first): the forces act as state variables, as section 2 proposes.
+""")
+
+# %% [markdown]
 # * **Differences from the paper.**  Moreau's figure 1 is a sketch: no dimensions, friction
 #   coefficient or numerical results are given.  Our geometry is symmetric, so the segment of
 #   $I$ lies on the vertical through $B$'s centre and the free parameter is the common normal
