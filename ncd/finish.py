@@ -18,7 +18,9 @@ method on the natural map):
    (one sparse LU, :func:`scipy.sparse.linalg.splu`);
 3. reads the statuses of the candidate from the regions of the natural map
    ``z = s - rho (U_n + mu |U_t|, U_t)`` (inside the cone: stick; in its polar:
-   open; else slide) and repeats until they stop changing; the candidate is
+   open; else slide) at the contacts whose natural map exceeds a fraction of the
+   tolerance (degenerate contacts, zero force or velocity at round-off, keep their
+   status) and repeats until they stop changing; the candidate is
    accepted only if its relative natural-map residual is ``<= finish_tol``;
 4. otherwise returns to NLGS sweeps (chunks growing 4x, within the sweep budget)
    and tries again from the new iterate (accepted as is if it reaches ``finish_tol``).
@@ -35,6 +37,7 @@ from .local_solver import NO_CONTACT, SLIDE_BACKWARD, SLIDE_FORWARD, STICK
 
 SWITCH_ROUNDS = 4        # status switches per attempt before returning to NLGS sweeps
 REFINE = 30              # iterated-Tikhonov refinements of one minimum-norm correction
+SWITCH_FRACTION = 1e-2   # a status switches where |F_c| > SWITCH_FRACTION * finish_tol * scale
 
 
 def global_delassus(scene, contacts):
@@ -146,11 +149,16 @@ def polish(W, q, mu, rho, scale, s0, status0, tol, more_sweeps=None, max_sweeps=
                 best = (res, cand, region)
             if res <= tol:
                 return cand, region, res, rounds, True, extra
-            key = region.tobytes()
-            if np.array_equal(region, status) or key in seen:
+            # switch only where the law is violated by more than a fraction of the tolerance:
+            # degenerate contacts (force on a region boundary, velocity at round-off) keep
+            # their status, which satisfies both conditions (else the statuses cycle)
+            wrong = np.sqrt(np.sum(F ** 2, axis=1)) > SWITCH_FRACTION * tol * max(scale, np.linalg.norm(cand))
+            new = np.where(wrong, region, status).astype(np.int8)
+            key = new.tobytes()
+            if np.array_equal(new, status) or key in seen:
                 break
             seen.add(key)
-            status = region
+            status = new
         if more_sweeps is None or extra >= max_sweeps:
             return best[1], best[2], best[0], rounds, False, extra
         k = min(chunk, max_sweeps - extra)

@@ -45,17 +45,40 @@ def test_polish_reaches_exact_solution(column):
 
 
 def test_polish_agrees_with_nlgs_limit(column):
-    """Where NLGS converges (to 1e-13 here), the polish of its 1e-8 iterate (same review
-    order) lands on the same solution, although the forces are indeterminate."""
+    """Where NLGS converges (to 1e-13 here), the polish of its iterates (same review
+    order) lands next to the same solution, although the forces are indeterminate: the
+    minimum-norm correction removes the iterate's error across the solution set, not
+    along it, so the polished point is closer to the limit than the iterate (measured:
+    2.0e-7 against 4.9e-7 from the 1e-8 iterate, 2.0e-9 from the 1e-10 one)."""
     scene, problem = column
     order = np.random.default_rng(5).permutation(problem.contacts.n)
     limit, _, _ = ncd.solve_problem(scene, problem, None, order, ncd.SolverSettings(tol=1e-13, max_sweeps=200000))
     assert limit.converged
-    fin, _, _ = ncd.solve_problem(scene, problem, None, order,
-                                  ncd.SolverSettings(tol=1e-8, finish="active_set", finish_tol=1e-12))
-    assert fin.converged and fin.residual <= 1e-12
-    rel = np.linalg.norm(fin.impulse - limit.impulse) / np.linalg.norm(limit.impulse)
-    assert rel < 1e-7
+    dist = lambda s: np.linalg.norm(s - limit.impulse) / np.linalg.norm(limit.impulse)
+    for tol, bound in [(1e-8, 5e-7), (1e-10, 1e-8)]:
+        start, _, _ = ncd.solve_problem(scene, problem, None, order, ncd.SolverSettings(tol=tol))
+        fin, _, _ = ncd.solve_problem(scene, problem, None, order,
+                                      ncd.SolverSettings(tol=tol, finish="active_set", finish_tol=1e-12))
+        assert fin.converged and fin.residual <= 1e-12
+        assert dist(fin.impulse) < min(bound, 0.6 * dist(start.impulse))
+
+
+def test_polish_dense_packing_degenerate_contacts():
+    """A dense packing under gravity has many degenerate contacts (force on the cone
+    edge or zero, velocity at round-off).  Leaving them in their status, the polish of
+    the 1e-4 NLGS iterate settles in two rounds without further sweeps (switching them
+    too cycled for 9 rounds and 250 more sweeps)."""
+    from ncd.studies.bench import dense_packing
+    scene = dense_packing(100)
+    problem = ncd.prepare_step(scene, H)
+    plain, _, _ = ncd.solve_problem(scene, problem, settings=ncd.SolverSettings(tol=1e-4, check_every=10))
+    fin, vel, spin = ncd.solve_problem(scene, problem, settings=ncd.SolverSettings(
+        tol=1e-4, check_every=10, finish="active_set", finish_tol=1e-10))
+    assert fin.converged and fin.residual <= 1e-10
+    assert fin.finish_rounds <= 3 and fin.sweeps == plain.sweeps
+    chk = check_solution(fin.impulse, _velocities(problem, vel, spin), problem.contacts.mu, tol=1e-9,
+                         velocity_scale=np.linalg.norm(scene.gravity) * H)
+    assert chk["ok"], chk
 
 
 def test_polish_local_form_unique_solution():
