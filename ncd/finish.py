@@ -96,7 +96,8 @@ def status_system(mu, status):
 
 def min_norm_solve(K, r, eps_rel=1e-10):
     """Minimum-norm solution of the consistent system ``K d = r`` (iterated Tikhonov on
-    ``[[I, K^T], [K, -eps I]]``, one sparse LU); the least-squares one otherwise."""
+    ``[[I, K^T], [K, -eps I]]``, one sparse LU, refined while each step at least halves
+    the residual); a truncated least-squares one otherwise."""
     m = K.shape[0]
     if m == 0:
         return np.zeros(0)
@@ -105,11 +106,15 @@ def min_norm_solve(K, r, eps_rel=1e-10):
     lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
                   options={"SymmetricMode": True})
     d = np.zeros(m)
-    rnorm = np.linalg.norm(r)
+    rnorm, prev = np.linalg.norm(r), np.inf
     for _ in range(REFINE):
         e = r - K @ d
-        if np.linalg.norm(e) <= 1e-15 * max(rnorm, 1e-300):
+        enorm = np.linalg.norm(e)
+        # stop at round-off, or when a refinement no longer halves the residual (the
+        # rest lies along nearly singular modes: a truncated minimum-norm correction)
+        if enorm <= 1e-15 * max(rnorm, 1e-300) or enorm > 0.5 * prev:
             break
+        prev = enorm
         d += lu.solve(np.concatenate([np.zeros(m), e]))[:m]
     return d
 
