@@ -21,7 +21,8 @@ method on the natural map):
    open; else slide) at the contacts whose natural map exceeds a fraction of the
    tolerance (degenerate contacts, zero force or velocity at round-off, keep their
    status) and repeats until they stop changing; the candidate is
-   accepted only if its relative natural-map residual is ``<= finish_tol``;
+   accepted only if its relative natural-map residual is ``<= finish_tol``
+   (:data:`SWITCH_ROUNDS` rounds per attempt, more while fewer contacts switch each round);
 4. otherwise returns to NLGS sweeps (chunks growing 4x, within the sweep budget)
    and tries again from the new iterate (accepted as is if it reaches ``finish_tol``).
 
@@ -36,6 +37,7 @@ from .contacts import h_matrix
 from .local_solver import NO_CONTACT, SLIDE_BACKWARD, SLIDE_FORWARD, STICK
 
 SWITCH_ROUNDS = 4        # status switches per attempt before returning to NLGS sweeps
+MAX_SWITCH_ROUNDS = 12   # ... or more while the number of switched contacts keeps falling
 REFINE = 30              # iterated-Tikhonov refinements of one minimum-norm correction
 SWITCH_FRACTION = 1e-2   # a status switches where |F_c| > SWITCH_FRACTION * finish_tol * scale
 
@@ -143,9 +145,10 @@ def polish(W, q, mu, rho, scale, s0, status0, tol, more_sweeps=None, max_sweeps=
             best = (res, s_base, status)
         if res <= tol:                   # NLGS got there by itself
             return s_base, status, res, rounds, True, extra
-        seen = set()
-        for _ in range(SWITCH_ROUNDS):
+        seen, switches, k_round = set(), np.inf, 0
+        while k_round < SWITCH_ROUNDS or (k_round < MAX_SWITCH_ROUNDS and shrinking):
             rounds += 1
+            k_round += 1
             cand = project_statuses(W, q, mu, s_base, status)
             U = (W @ cand.ravel() + q).reshape(-1, 2)
             F, region = natural_map(cand, U, mu, rho)
@@ -163,6 +166,8 @@ def polish(W, q, mu, rho, scale, s0, status0, tol, more_sweeps=None, max_sweeps=
             if np.array_equal(new, status) or key in seen:
                 break
             seen.add(key)
+            shrinking = np.count_nonzero(new != status) < switches   # statuses settling: go on
+            switches = np.count_nonzero(new != status)
             status = new
         if more_sweeps is None or extra >= max_sweeps:
             return best[1], best[2], best[0], rounds, False, extra
