@@ -16,10 +16,9 @@ netCDF file per pile.
 import numpy as np
 import xarray as xr
 
-from . import cuts as cm
-from .construction import FRAME, build
-from .pile import construction_dataset, make_ground, pile_scene
-from .sources import PointSource, RainSource, mean_diameter
+from .construction import add_frames, build
+from .pile import construction_dataset, free_surface, make_ground, pile_scene
+from .sources import PointSource, RainSource
 
 HISTORIES = ("point", "rain")
 STREAMS = {"ground": 0, "radii": 1, "point": 2, "rain": 3}
@@ -39,13 +38,7 @@ def grain_radii(cfg, member):
 def base_half_width(cfg, pos, radius, y0):
     """``(L, fits)``: the base half-width ``(right toe - left toe) / 2`` of the flank fits of
     the free surface (profile bins ``surface.bin_d``, fits between ``surface.fit_range``)."""
-    d = mean_diameter(cfg)
-    sb = cfg["surface"]["bin_d"] * d
-    m = int(np.ceil((np.abs(pos[:, 0]).max() + d) / sb))
-    edges = np.arange(-m, m + 1) * sb
-    xs = 0.5 * (edges[1:] + edges[:-1])
-    height = cm.surface_profile(pos, radius, edges) - y0
-    fits = cm.fit_flanks(xs, height, 0.0, cfg["surface"]["fit_range"])
+    fits = free_surface(cfg, pos, radius, y0)[2]
     return 0.5 * (fits["right"]["toe"] - fits["left"]["toe"]), fits
 
 
@@ -83,15 +76,7 @@ def pile_dataset(cfg, history, member, scene, rec, ground, eq, frames, rain_half
     nm = scene.n_mobile
     y0 = float(np.mean(ground[1]))
     L, fits = base_half_width(cfg, scene.pos[:nm], scene.radius[:nm], y0)
-    steps, fr = frames
-    units = {"x": "m", "y": "m", "radius": "m", "vx": "m s-1", "vy": "m s-1", "spin": "rad s-1"}
-    names = {"x": "centre x", "y": "centre y", "radius": "radius", "vx": "velocity x", "vy": "velocity y",
-             "spin": "angular velocity"}
-    for j, q in enumerate(FRAME):
-        ds[f"frame_{q}"] = (("frame", "disc"), fr[:, j, :],
-                            {"units": units[q], "long_name": f"grain {names[q]} in a stored frame (NaN: not yet poured)"})
-    ds["frame_step"] = ("frame", steps, {"units": "1", "long_name": "construction step of the frame"})
-    ds["frame_time"] = ("frame", steps * cfg["h"], {"units": "s", "long_name": "time of the frame"})
+    add_frames(ds, frames, cfg["h"])
     ds.attrs.update(history=history, member=int(member), root_seed=int(cfg["root_seed"]), y_ground=y0,
                     base_half_width=float(L), rain_half_width=np.nan if rain_half_width is None else
                     float(rain_half_width), construction_wall_time=float(np.sum(rec["wall_time"])),

@@ -127,6 +127,19 @@ def _cut_specs(ds):
     return list(zip(ds["cut_x"].values, ds["outer"].values.astype(int), ds["y_lo"].values, ds["y_hi"].values))
 
 
+def free_surface(cfg, pos, radius, y0):
+    """``(xs, height, fits, m, bin)``: the free-surface profile above ``y0`` in bins of
+    ``surface.bin_d`` mean diameters (``2 m`` bins centred at ``xs``) and its flank fits
+    between ``surface.fit_range`` (:func:`ncd.figures.cuts.fit_flanks`)."""
+    d = mean_diameter(cfg)
+    sb = cfg["surface"]["bin_d"] * d
+    m = int(np.ceil((np.abs(pos[:, 0]).max() + d) / sb))
+    edges = np.arange(-m, m + 1) * sb
+    xs = 0.5 * (edges[1:] + edges[:-1])
+    height = cm.surface_profile(pos, radius, edges) - y0
+    return xs, height, cm.fit_flanks(xs, height, 0.0, cfg["surface"]["fit_range"]), m, sb
+
+
 def cuts_dataset(cfg, construction):
     """cuts.nc: free-surface profile and flank fits, the cuts (default, moved by
     ``± shift_d`` mean diameters, a scan of both flanks) with their history resultants,
@@ -139,13 +152,7 @@ def cuts_dataset(cfg, construction):
     pos, radius = scene.pos[:nm], scene.radius[:nm]
     forces = np.column_stack([ds["force_n"].values, ds["force_t"].values]).ravel()
     y0 = float(np.mean(ds["ground_radius"].values))          # ground level: mean top of the ground discs
-    # free surface
-    sb = cfg["surface"]["bin_d"] * d
-    m = int(np.ceil((np.abs(pos[:, 0]).max() + d) / sb))
-    edges = np.arange(-m, m + 1) * sb
-    xs = 0.5 * (edges[1:] + edges[:-1])
-    height = cm.surface_profile(pos, radius, edges) - y0
-    fits = cm.fit_flanks(xs, height, 0.0, cfg["surface"]["fit_range"])
+    xs, height, fits, m, sb = free_surface(cfg, pos, radius, y0)
     # cuts
     k = cfg["cut"]
     depth = lambda x: float(np.interp(x, xs[np.isfinite(height)], height[np.isfinite(height)]))  # noqa: E731
