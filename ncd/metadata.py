@@ -156,6 +156,26 @@ KNOWN = {
     "limits_distance_velocity": ("1", "distance between the references of two inits (velocity)"),
     "reference": ("1", "reference value of the quantity"), "value": ("1", "value of the quantity"),
     "work": ("1", "CD: sum of sweeps x contacts; MD: steps x candidate pairs"),
+    # the benchmark suite (ncd.studies.bench, results/bench/*.nc)
+    "size": ("1", "discs of the benchmark packing"), "threads": ("1", "threads of the ensemble run"),
+    "speedup": ("1", "wall time on one thread over wall time on this many threads"),
+    "same_results": ("1", "outputs identical to the one-thread run, bit for bit", FLAG),
+    "digest": ("1", "SHA-256 digest of every output of the ensemble"),
+    "engine": ("1", "simulation engine"), "solver": ("1", "solver (plain NLGS or NLGS with the finishing stage)"),
+    "job": ("1", "job index"), "figure": ("1", "figure"), "rule": ("1", "rule or job name"),
+    "seconds": ("s", "wall time of the job"), "max_rss_mb": ("MB", "peak resident memory of the job"),
+    "sweeps_zero": ("1", "NLGS sweeps to the tolerance from the zero guess"),
+    "residual_zero": ("1", "relative natural-map residual reached from the zero guess"),
+    "converged_zero": ("1", "reached the tolerance from the zero guess", FLAG),
+    "wall_time_zero": ("s", "wall time of the solve from the zero guess"),
+    "sweeps_interleaved": ("1", "NLGS sweeps to the tolerance from the zero guess, interleaved review order"),
+    "residual_interleaved": ("1", "relative natural-map residual reached from the zero guess, interleaved review order"),
+    "converged_interleaved": ("1", "reached the tolerance from the zero guess, interleaved review order", FLAG),
+    "wall_time_interleaved": ("s", "wall time of the solve from the zero guess, interleaved review order"),
+    "sweeps_warm": ("1", "NLGS sweeps to the tolerance from the warm guess"),
+    "residual_warm": ("1", "relative natural-map residual reached from the warm guess"),
+    "converged_warm": ("1", "reached the tolerance from the warm guess", FLAG),
+    "wall_time_warm": ("s", "wall time of the solve from the warm guess"),
 }
 
 # name prefixes whose rest is a name of KNOWN (``scan_zero_sweeps``: sweeps of the scan, zero guess)

@@ -124,6 +124,54 @@ def clip_polygon(box, normals, values):
     return poly
 
 
+def support_polygon(query, dirs, eps, max_lp, scale):
+    """Exact convex polygon from support queries: ``query(u)`` returns the point of the
+    set maximizing ``u . p`` (2-D).  Support points in the directions ``dirs`` start an
+    inner polygon (their hull); each edge is then tested along its outer normal: if
+    nothing lies beyond it by more than ``eps`` it is a true edge, otherwise the new
+    point is added, until every edge is confirmed (or ``max_lp`` queries).  Returns
+    ``vertices`` (ccw), ``inner_area``, ``outer_area`` (the polygon of all supporting
+    half-planes), ``n_lp`` and ``exact``; ``scale`` sizes the outer polygon's box."""
+    normals, values, pts = [], [], []
+
+    def ask(u):
+        p = np.asarray(query(u), dtype=float)
+        normals.append(u)
+        values.append(float(u @ p))
+        pts.append(p)
+        return p
+
+    for u in dirs:
+        ask(u)
+    confirmed = set()
+    n_lp = len(dirs)
+    exact = False
+    while n_lp < max_lp:
+        hull = convex_hull(pts, tol=eps)
+        edges = [(hull[k], hull[(k + 1) % len(hull)]) for k in range(len(hull))] if len(hull) > 1 else []
+        if len(hull) == 2:       # a segment: test both sides
+            edges = [(hull[0], hull[1]), (hull[1], hull[0])]
+        todo = [(a, b) for a, b in edges if (tuple(a), tuple(b)) not in confirmed]
+        if not todo:
+            exact = True
+            break
+        for a, b in todo:
+            e = b - a
+            u = np.array([e[1], -e[0]]) / np.hypot(*e)
+            q = ask(u)
+            n_lp += 1
+            if u @ q <= u @ a + eps:
+                confirmed.add((tuple(a), tuple(b)))
+    hull = convex_hull(pts, tol=eps)
+    if len(hull) == 1:   # every direction met the same point
+        exact = exact or len(dirs) >= 3
+    span = max(np.ptp(np.array(pts), axis=0).max(), scale)
+    box = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]]) * 10 * span + np.array(pts).mean(0)
+    outer = clip_polygon(box, normals, np.array(values) + eps)
+    return {"vertices": hull, "inner_area": polygon_area(hull), "outer_area": polygon_area(outer),
+            "n_lp": n_lp, "exact": bool(exact)}
+
+
 @njit(cache=True)
 def _hit_and_run(G, slack, y, L, thin, normals, uniforms):
     """Hit-and-run steps in ``{y : G y <= b}``, ``slack = b - G y`` kept up to date (both
@@ -255,46 +303,9 @@ class ForcePolytope:
         force units), ``inner_area``, ``outer_area``, ``n_lp``, ``exact``.
         Requires a bounded ``A ∩ C``.
         """
-        eps = tol * self.scale
         dirs = [np.array([np.cos(a), np.sin(a)]) for a in 2 * np.pi * np.arange(n_init) / max(n_init, 3)]
-        normals, values, pts = [], [], []
-
-        def query(u):
-            p = self.support(contact, u)[2 * contact: 2 * contact + 2]
-            normals.append(u)
-            values.append(float(u @ p))
-            pts.append(p)
-            return p
-
-        for u in dirs:
-            query(u)
-        confirmed = set()
-        n_lp = len(dirs)
-        exact = False
-        while n_lp < max_lp:
-            hull = convex_hull(pts, tol=eps)
-            edges = [(hull[k], hull[(k + 1) % len(hull)]) for k in range(len(hull))] if len(hull) > 1 else []
-            if len(hull) == 2:       # a segment: test both sides
-                edges = [(hull[0], hull[1]), (hull[1], hull[0])]
-            todo = [(a, b) for a, b in edges if (tuple(a), tuple(b)) not in confirmed]
-            if not todo:
-                exact = True
-                break
-            for a, b in todo:
-                e = b - a
-                u = np.array([e[1], -e[0]]) / np.hypot(*e)
-                q = query(u)
-                n_lp += 1
-                if u @ q <= u @ a + eps:
-                    confirmed.add((tuple(a), tuple(b)))
-        hull = convex_hull(pts, tol=eps)
-        if len(hull) == 1:   # every direction met the same point
-            exact = exact or len(dirs) >= 3
-        span = max(np.ptp(np.array(pts), axis=0).max(), self.scale)
-        box = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]]) * 10 * span + np.array(pts).mean(0)
-        outer = clip_polygon(box, normals, np.array(values) + eps)
-        return {"vertices": hull, "inner_area": polygon_area(hull), "outer_area": polygon_area(outer),
-                "n_lp": n_lp, "exact": bool(exact)}
+        return support_polygon(lambda u: self.support(contact, u)[2 * contact: 2 * contact + 2],
+                               dirs, tol * self.scale, max_lp, self.scale)
 
     # ------------------------------------------------------------ uniform sampling
     def affine_hull(self, tol=1e-9):

@@ -259,7 +259,7 @@ def test_exact_polygons_contain_every_converged_rest_run(data):
         assert out.max(initial=0.0) <= 1e-8 * W, f"cut {k}: {out.max() / W:.2e} W outside"
         assert 0.0 <= cov <= 1.0 + 1e-9
     assert ex.history_outside.max() <= 1e-6 * W
-    assert ex.exact.values.all() and ex.n_lp[0] >= data["cfg"]["exact"]["n_dirs"]
+    assert ex.exact.values.all() and ex.n_lp[0] >= yaml.safe_load(ex.attrs["config_yaml"])["exact"]["n_dirs"]
 
 
 def test_lp_vertices_are_admissible_and_the_dip_verdict_follows_the_numbers(data):

@@ -30,7 +30,7 @@ import xarray as xr
 
 from ..contacts import h_matrix
 from ..io import provenance
-from ..polytope import ForcePolytope, PolytopeError, clip_polygon, convex_hull, polygon_area
+from ..polytope import ForcePolytope, PolytopeError, polygon_area, support_polygon
 from . import cuts as cm
 
 FEAS_TOL = 1e-10
@@ -43,7 +43,7 @@ class ExactSet:
         self.fp = fp = ForcePolytope(H, F, mu)
         self.scale, self.n = fp.scale, 2 * fp.n_contacts
         A = sp.vstack([fp.A_eq, fp.G]).tocsc()
-        m_eq, m_ub = fp.A_eq.shape[0], fp.G.shape[0]
+        m_ub = fp.G.shape[0]
         lp = highspy.HighsLp()
         lp.num_col_, lp.num_row_ = self.n, A.shape[0]
         inf = highspy.kHighsInf
@@ -122,45 +122,17 @@ class ExactSet:
         support points' full force vectors, one per LP).
         """
         L = sp.csr_matrix(L)
-        eps = tol * self.scale
-        normals, values, pts, full = [], [], [], []
+        full = []
 
         def query(u):
-            c = -(L.T @ u)
-            _, r = self.minimize(c)
-            p = L @ r
-            normals.append(u)
-            values.append(float(u @ p))
-            pts.append(p)
+            _, r = self.minimize(-(L.T @ u))
             full.append(r)
-            return p
+            return L @ r
 
-        for a in 2 * np.pi * np.arange(n_dirs) / n_dirs:
-            query(np.array([np.cos(a), np.sin(a)]))
-        confirmed, exact, n_lp = set(), False, n_dirs
-        while n_lp < max_lp:
-            hull = convex_hull(pts, tol=eps)
-            if len(hull) < 3:
-                exact = True           # a point or a segment, met from every direction
-                break
-            todo = [(hull[k], hull[(k + 1) % len(hull)]) for k in range(len(hull))]
-            todo = [(a, b) for a, b in todo if (tuple(a), tuple(b)) not in confirmed]
-            if not todo:
-                exact = True
-                break
-            for a, b in todo:
-                e = b - a
-                u = np.array([e[1], -e[0]]) / np.hypot(*e)
-                q = query(u)
-                n_lp += 1
-                if u @ q <= u @ a + eps:
-                    confirmed.add((tuple(a), tuple(b)))
-        hull = convex_hull(pts, tol=eps)
-        span = max(np.ptp(np.array(pts), axis=0).max(), self.scale)
-        box = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]]) * 10 * span + np.array(pts).mean(0)
-        outer = clip_polygon(box, normals, np.array(values) + eps)
-        return {"vertices": hull, "inner_area": polygon_area(hull), "outer_area": polygon_area(outer),
-                "n_lp": n_lp, "exact": bool(exact), "points": np.array(full)}
+        dirs = [np.array([np.cos(a), np.sin(a)]) for a in 2 * np.pi * np.arange(n_dirs) / n_dirs]
+        out = support_polygon(query, dirs, tol * self.scale, max_lp, self.scale)
+        out["points"] = np.array(full)
+        return out
 
 
 def _min_norm(K, r, eps=1e-12, refine=20):

@@ -41,12 +41,13 @@ ENSEMBLE_THREADS = 2
 NCD_CORE = sorted(str(REL / "ncd" / p.name) for p in (ROOT / "ncd").glob("*.py"))
 NCD_MODULES = {
     "fig1_wedged": ["figures/__init__.py", "figures/wedged.py"],
-    "fig2_slope": ["figures/__init__.py", "figures/slope.py", "figures/slope_analysis.py"],
-    "fig3_equilibrium": ["figures/__init__.py", "figures/equilibrium.py"],
+    "fig2_slope": ["figures/__init__.py", "figures/slope.py", "figures/slope_analysis.py", "figures/census.py"],
+    "fig3_equilibrium": ["figures/__init__.py", "figures/equilibrium.py", "figures/faces.py"],
     "fig4_pile": ["figures/__init__.py", "figures/pile.py", "figures/cuts.py", "figures/construction.py",
-                  "figures/sources.py"],
+                  "figures/sources.py", "figures/pile_exact.py", "figures/pressure.py"],
     "fig4_history": ["figures/__init__.py", "figures/pile.py", "figures/cuts.py", "figures/construction.py",
-                     "figures/sources.py", "figures/history.py", "figures/history_analysis.py"],
+                     "figures/sources.py", "figures/history.py", "figures/history_analysis.py",
+                     "figures/history_plots.py"],
     "fig5_governing": ["figures/__init__.py", "figures/equilibrium.py", "figures/governing.py",
                        "figures/governing_exact.py", "figures/governing_plot.py"],
     "stability": ["studies/__init__.py", "studies/stability.py", "studies/scenes.py"],

@@ -4,6 +4,5 @@ from ncd.pipeline import start
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)
 ds = merge_shards(snakemake.input, dim=snakemake.params.dim)  # noqa: F821
-ds.attrs.pop("title", None)  # the first shard's (names its shard count): write_dataset titles the merged file
 write_dataset(ds, snakemake.output[0])  # noqa: F821
 log.info("merged %d shards, %d members", len(snakemake.input), ds.sizes[snakemake.params.dim])  # noqa: F821
