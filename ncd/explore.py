@@ -85,12 +85,6 @@ def explore(scene, problem, members, root_seed, init="zero", review="random", gu
     """
     members = checks.explore_args(scene, problem, members, root_seed, init, review, guess_scale,
                                   settings, progress, threads)
-    if init not in INIT_MODES:
-        raise ValueError(f"init = {init!r} must be one of {INIT_MODES}")
-    if review not in ("fixed", "random"):
-        raise ValueError(f"review = {review!r} must be 'fixed' or 'random'")
-    if init == "random" and not (guess_scale and guess_scale > 0):
-        raise ValueError(f"init = 'random' needs guess_scale > 0, got {guess_scale!r}")
     members = np.asarray(members, dtype=np.int64)
     n = problem.contacts.n
     nm = scene.n_mobile
