@@ -107,7 +107,7 @@ def test_rain_source_and_same_grains():
     p, r = src.draw(np.zeros((0, 2)), np.zeros(0), 30)
     assert len(r) > 5 and np.all(np.abs(p[:, 0]) <= 0.01)
     assert np.array_equal(r, r1[:len(r)])           # taken in order
-    with pytest.raises(ValueError, match="rain_half_width"):
+    with pytest.raises(ValueError, match="point_half_width"):
         history.construct(cfg, "rain", 0)
     with pytest.raises(ValueError, match="history"):
         history.construct(cfg, "sieve", 0)

@@ -9,7 +9,16 @@ generators ``default_rng((m, root_seed, stream))``:
 
 The rain falls uniformly over ``|x| <= width_fraction * L``, ``L`` the base
 half-width of the point-source pile of the same member (from its flank fits), so a
-rain pile's rule reads that pile's file.  Construction: :func:`ncd.figures.construction.build`
+rain pile's rule reads that pile's file.  As in the experiments (sand rained through
+a sieve onto a base of finite size: Vanel et al. 1999; Geng et al. 2001), the rain
+pile stands on a finite base: the member's ground discs with ``|x| <= L`` only.
+Grains that roll off its edges are removed from the simulation once their centre
+falls ``DROP_D`` mean diameters below the ground discs' centres
+(:func:`ncd.figures.construction.build`), and the rain goes on, from the same
+sequence of radii (stream 1, continued past ``grains.n``), until ``grains.n`` grains
+stand on the base or ``rain.pour_limit * grains.n`` have been poured: the rain pile
+holds as many grains as the point pile (unless the limit stops it: ``n_grains`` and
+``n_removed`` say), its first ``grains.n`` poured grains are the point pile's.  Construction: :func:`ncd.figures.construction.build`
 (checkpoints, frames); the final state, its history forces and the frames go to one
 netCDF file per pile.
 """
@@ -18,9 +27,10 @@ import xarray as xr
 
 from .construction import add_frames, build
 from .pile import construction_dataset, free_surface, make_ground, pile_scene
-from .sources import PointSource, RainSource
+from .sources import PointSource, RainSource, mean_diameter
 
 HISTORIES = ("point", "rain")
+DROP_D = 2.0     # a grain this far (mean diameters) below the ground discs' centres has left the base
 STREAMS = {"ground": 0, "radii": 1, "point": 2, "rain": 3}
 
 
@@ -29,10 +39,13 @@ def member_rng(member, root_seed, stream):
     return np.random.default_rng((int(member), int(root_seed), STREAMS[stream]))
 
 
-def grain_radii(cfg, member):
-    """The radii of the grains of pile ``member``, in order of insertion (both histories)."""
+def grain_radii(cfg, member, count=None):
+    """The radii of the grains of pile ``member``, in order of insertion (both histories);
+    ``count`` (default ``grains.n``) radii of one sequence: a longer one starts with the
+    shorter (the rain pours past ``grains.n`` when grains fall off its base)."""
     g = cfg["grains"]
-    return member_rng(member, cfg["root_seed"], "radii").uniform(g["radius_min"], g["radius_max"], g["n"])
+    n = g["n"] if count is None else int(count)
+    return member_rng(member, cfg["root_seed"], "radii").uniform(g["radius_min"], g["radius_max"], n)
 
 
 def base_half_width(cfg, pos, radius, y0):
@@ -42,10 +55,21 @@ def base_half_width(cfg, pos, radius, y0):
     return 0.5 * (fits["right"]["toe"] - fits["left"]["toe"]), fits
 
 
-def construct(cfg, history, member, rain_half_width=None, log=None, checkpoint=None):
+def finite_base(ground, half_width):
+    """The ground discs with centres in ``|x| <= half_width`` (the base of a rain pile)."""
+    keep = np.abs(ground[0][:, 0]) <= half_width
+    if keep.sum() < 2:
+        raise ValueError(f"base half-width {half_width!r} m keeps fewer than 2 ground discs")
+    return ground[0][keep], ground[1][keep]
+
+
+def construct(cfg, history, member, point_half_width=None, log=None, checkpoint=None, info=None):
     """Build pile ``member`` of ``history``; returns :func:`build`'s tuple plus the ground.
 
-    ``rain_half_width`` (m) is required for ``history == "rain"``.
+    ``point_half_width`` (m, the base half-width ``L`` of the member's point-source pile)
+    is required for ``history == "rain"``: the rain falls over ``|x| <= width_fraction L``
+    onto the finite base ``|x| <= L`` (:func:`finite_base`).  ``info`` (a dict) receives
+    the insertion index of each grain and the removed grains (:func:`build`).
     """
     if history not in HISTORIES:
         raise ValueError(f"history = {history!r} must be one of {HISTORIES}")
@@ -54,32 +78,54 @@ def construct(cfg, history, member, rain_half_width=None, log=None, checkpoint=N
     y0 = float(np.mean(ground[1]))
     radii = grain_radii(cfg, member)
     rng = member_rng(member, root, history)
+    drop, limit = None, None
     if history == "point":
         source = PointSource(cfg, rng, y0, radii)
     else:
-        if rain_half_width is None:
-            raise ValueError("history 'rain' needs rain_half_width (the point-source pile's base half-width)")
-        source = RainSource(cfg, rng, y0, rain_half_width, cfg["rain"]["sites"], radii)
+        if point_half_width is None or not np.isfinite(point_half_width) or point_half_width <= 0:
+            raise ValueError(f"history 'rain' needs point_half_width > 0 (the point-source pile's base "
+                             f"half-width), got {point_half_width!r}")
+        ground = finite_base(ground, point_half_width)
+        limit = int(np.ceil(cfg["rain"]["pour_limit"] * len(radii)))
+        source = RainSource(cfg, rng, y0, cfg["rain"]["width_fraction"] * point_half_width,
+                            cfg["rain"]["sites"], grain_radii(cfg, member, limit))
+        drop = -DROP_D * mean_diameter(cfg)
     c = cfg["construction"]
     key = {**cfg, "history": history, "member": int(member),
-           "rain_half_width": None if rain_half_width is None else float(rain_half_width)}
+           "point_half_width": None if point_half_width is None else float(point_half_width)}
     factory = lambda p, r, v, w, a: pile_scene(cfg, p, r, *ground, vel=v, spin=w, angle=a)  # noqa: E731
+    info = {} if info is None else info
+    if limit is not None:       # the rain pours `limit` grains; those that roll off the base are removed
+        key["grains"] = {**cfg["grains"], "n": limit}
     scene, rec, eq, frames = build(key, ground, source, factory, log, checkpoint=checkpoint,
-                                   checkpoint_every=c["checkpoint_every"], frame_every=c["frame_every"])
+                                   checkpoint_every=c["checkpoint_every"], frame_every=c["frame_every"],
+                                   drop_below=drop, info=info)
     return scene, rec, ground, eq, frames
 
 
-def pile_dataset(cfg, history, member, scene, rec, ground, eq, frames, rain_half_width=None):
+def pile_dataset(cfg, history, member, scene, rec, ground, eq, frames, point_half_width=None, info=None):
     """One pile's file: :func:`ncd.figures.pile.construction_dataset` plus the frames,
-    the base half-width and the flank fits."""
+    the base half-width and the flank fits, the insertion index of every grain and the
+    count of grains removed off the base (``info`` of :func:`construct`)."""
     ds = construction_dataset(cfg, scene, rec, ground, eq)
     nm = scene.n_mobile
     y0 = float(np.mean(ground[1]))
     L, fits = base_half_width(cfg, scene.pos[:nm], scene.radius[:nm], y0)
     add_frames(ds, frames, cfg["h"])
+    info = info or {}
+    order = np.asarray(info.get("order", np.arange(nm)), np.int64)
+    removed = np.asarray(info.get("removed", np.zeros((0, 4))), float).reshape(-1, 4)
+    ds["poured_index"] = ("grain", order, {"units": "1", "long_name": "insertion index of the grain (same "
+                                           "sequence of radii for both histories of a member)"})
+    rain = history == "rain"
     ds.attrs.update(history=history, member=int(member), root_seed=int(cfg["root_seed"]), y_ground=y0,
-                    base_half_width=float(L), rain_half_width=np.nan if rain_half_width is None else
-                    float(rain_half_width), construction_wall_time=float(np.sum(rec["wall_time"])),
+                    base_half_width=float(L),
+                    point_half_width=float(point_half_width) if rain else float(L),
+                    rain_half_width=cfg["rain"]["width_fraction"] * float(point_half_width) if rain else np.nan,
+                    base_edge=float(np.max(np.abs(ground[0][:, 0]) + ground[1])) if rain else np.nan,
+                    n_poured=int(nm + len(removed)), n_removed=int(len(removed)),
+                    n_removed_left=int(np.sum(removed[:, 2] < 0)), n_removed_right=int(np.sum(removed[:, 2] > 0)),
+                    construction_wall_time=float(np.sum(rec["wall_time"])),
                     **{f"{f}_{q}": v for f in ("left", "right") for q, v in fits[f].items()})
     return ds
 

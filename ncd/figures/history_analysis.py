@@ -49,11 +49,9 @@ def dip_depth(profile, xi, center, flank):
 
 def norm_length(cfg, ds):
     """``L`` of ``xi = x / L``: the base half-width of the member's point-source pile (for a
-    rain pile, the rain's half-width over ``rain.width_fraction``), so that both piles of a
-    member share the abscissa (a rained layer has no well-defined toe of its own)."""
-    if ds.attrs["history"] == "point":
-        return float(ds.attrs["base_half_width"])
-    return float(ds.attrs["rain_half_width"]) / cfg["rain"]["width_fraction"]
+    rain pile, the half-width of its finite base), so that both piles of a member share
+    the abscissa."""
+    return float(ds.attrs["point_half_width"])
 
 
 def pile_measures(cfg, ds):
@@ -84,7 +82,8 @@ def pile_measures(cfg, ds):
                 base_half_width=L, n_ground=len(x), cut_angle=phi.reshape(2, -1), cut_deviation=dev.reshape(2, -1),
                 cut_count=np.asarray(counts).reshape(2, -1), surface_angle=slope.reshape(2, -1),
                 dip=dip_depth(prof, xi, a["dip_center"], a["dip_flank"]), apex_height=apex / d,
-                cone_ratio=apex / (fitL * tan), fit_half_width=float(ds.attrs["base_half_width"]))
+                cone_ratio=apex / (fitL * tan), fit_half_width=float(ds.attrs["base_half_width"]),
+                n_grains=nm, n_removed=int(ds.attrs.get("n_removed", 0)))
 
 
 def bootstrap_index(rng, n_piles, n_boot):
@@ -107,8 +106,22 @@ def permutation_p(dip_a, dip_b, profiles_a, profiles_b, xi, center, flank, rng, 
     return (count + 1) / (n_perm + 1)
 
 
-def ensemble_dataset(cfg, files):
-    """analysis.nc from ``files = {history: [pile datasets in member order]}``."""
+def exact_arrays(exact, hist, n, shape):
+    """``(dev_min, dev_max, history_outside, computed)`` over (history, pile, flank, position)
+    from ``exact = {(history, member): dataset of ncd.figures.history_exact}``; NaN where absent."""
+    lo, hi, out = (np.full((len(hist), n) + shape, np.nan) for _ in range(3))
+    done = np.zeros((len(hist), n), np.int8)
+    for (h, m), e in (exact or {}).items():
+        i = hist.index(h)
+        lo[i, m], hi[i, m] = e["exact_deviation_min"].values, e["exact_deviation_max"].values
+        out[i, m] = e["history_outside"].values
+        done[i, m] = 1
+    return lo, hi, out, done
+
+
+def ensemble_dataset(cfg, files, exact=None):
+    """analysis.nc from ``files = {history: [pile datasets in member order]}`` and the exact
+    angle ranges ``exact = {(history, member): dataset}`` of some piles."""
     a = cfg["analysis"]
     hist = [h for h in HISTORIES if h in files]
     per = {h: [pile_measures(cfg, ds) for ds in files[h]] for h in hist}
@@ -135,6 +148,7 @@ def ensemble_dataset(cfg, files):
     ang = stack("cut_angle")
     q = np.asarray(a["cut_positions"], float)
     boot_med = np.median(dev[:, idx], axis=2)     # (history, B, flank, position)
+    ex_lo, ex_hi, ex_out, ex_done = exact_arrays(exact, hist, n, dev.shape[2:])
     one = lambda dims, v, u, ln: (dims, v, {"units": u, "long_name": ln})  # noqa: E731
     H, P, K, X, F, Q = "history", "pile", "kernel", "xi", "flank", "cut_position"
     out = xr.Dataset(
@@ -177,6 +191,15 @@ def ensemble_dataset(cfg, files):
             "apex_height": one((H, P), stack("apex_height"), "1", "highest grain top above the ground, in d"),
             "cone_ratio": one((H, P), stack("cone_ratio"), "1",
                               "apex height / (L tan(mean flank angle)): 1 for a cone, < 1 flat-topped"),
+            "n_grains": one((H, P), stack("n_grains"), "1", "grains in the final pile"),
+            "n_removed": one((H, P), stack("n_removed"), "1", "poured grains that rolled off the base (removed)"),
+            "exact_deviation_min": one((H, P, F, Q), ex_lo, "degree", "exact minimum over A ∩ C of the cut "
+                                       "resultant angle minus the flank slope (NaN: not computed)"),
+            "exact_deviation_max": one((H, P, F, Q), ex_hi, "degree", "exact maximum over A ∩ C of the cut "
+                                       "resultant angle minus the flank slope (NaN: not computed)"),
+            "exact_history_outside": one((H, P, F, Q), ex_out, "N", "distance of the history resultant "
+                                         "outside the exact polygon (NaN: not computed)"),
+            "exact_computed": one((H, P), ex_done, "1", "exact angle ranges computed for this pile"),
         },
         coords={H: hist, P: np.arange(n), K: widths, X: xi, F: ["left", "right"], Q: q},
         attrs={"level": a["level"], "bootstrap": B, "permutations": a["permutations"],

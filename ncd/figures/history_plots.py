@@ -67,9 +67,20 @@ def plot_dips(ax, an):
 
 def plot_arching(ax, an):
     """Median over piles of the cut resultant's deviation from the free-surface slope,
-    band: 25-75 % of the piles (shaded) and bootstrap band of the median (bars)."""
+    band: 25-75 % of the piles (shaded) and bootstrap band of the median (bars); thin
+    vertical lines: the exact range over A ∩ C of single piles (where computed)."""
     q = an.cut_position.values
+    step = np.min(np.diff(q)) if len(q) > 1 else 0.1
     for i, h in enumerate(an.history.values):
+        if "exact_computed" in an:
+            done = np.nonzero(an.exact_computed.sel(history=h).values)[0]
+            for j, m in enumerate(done):
+                for f, sign in (("left", -1), ("right", 1)):
+                    s = an.sel(history=h, pile=m, flank=f)
+                    x = sign * q + (i - 0.5) * 0.35 * step + 0.3 * step * (j + 0.5) / max(len(done), 1) * sign
+                    ax.vlines(x, s.exact_deviation_min, s.exact_deviation_max, color=COLORS[h], lw=0.6, alpha=0.6,
+                              label=f"{LABELS[h]}: exact range, {len(done)} piles" if (j == 0 and f == "left")
+                              else None)
         for f, sign in (("left", -1), ("right", 1)):
             s = an.sel(history=h, flank=f)
             x = sign * q
@@ -114,6 +125,18 @@ def summary(an):
                       dev_iqr=float(an.cut_deviation.sel(history=h).quantile(0.75)
                                     - an.cut_deviation.sel(history=h).quantile(0.25)),
                       arching=float((an.cut_deviation.sel(history=h) > 0).mean()))
+    for h in an.history.values:
+        out[h].update(grains=float(an.n_grains.sel(history=h).mean()),
+                      grains_min=int(an.n_grains.sel(history=h).min()), grains_max=int(an.n_grains.sel(history=h).max()),
+                      removed=float(an.n_removed.sel(history=h).mean()))
+        if "exact_computed" in an and int(an.exact_computed.sel(history=h).sum()):
+            e = an.sel(history=h).where(an.exact_computed.sel(history=h) == 1, drop=True)
+            width = (e.exact_deviation_max - e.exact_deviation_min).values
+            out[h].update(exact_piles=int(e.sizes["pile"]), exact_width_median=float(np.nanmedian(width)),
+                          exact_width_max=float(np.nanmax(width)),
+                          exact_all_positive=float(np.mean(e.exact_deviation_min.values > 0)),
+                          exact_all_negative=float(np.mean(e.exact_deviation_max.values < 0)),
+                          exact_undefined=float(np.mean(np.isnan(width))))
     out["diff"] = float(an.dip_diff.sel(kernel=k0))
     out["diff_lo"], out["diff_hi"] = float(an.dip_diff_lo.sel(kernel=k0)), float(an.dip_diff_hi.sel(kernel=k0))
     out["p"] = {float(k): float(an.dip_diff_p.sel(kernel=k)) for k in an.kernel.values}

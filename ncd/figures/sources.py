@@ -50,10 +50,10 @@ class _Source:
     def _radius(self):
         return self.rng.uniform(self.rmin, self.rmax) if self.radii is None else self.radii[self.taken]
 
-    def _try(self, x, r, pos, radius, new_p, new_r):
-        """Insert a grain of radius ``r`` at ``(x, height)`` if it clears every grain by 0.05 d."""
+    def _try(self, x, r, pos, radius, new_p, new_r, dy=0.0):
+        """Insert a grain of radius ``r`` at ``(x, height + dy)`` if it clears every grain by 0.05 d."""
         clear = 0.05 * self.d
-        p = np.array([x, self.height])
+        p = np.array([x, self.height + dy])
         ok = len(radius) == 0 or np.min(np.hypot(*(pos - p).T) - radius - r) > clear
         ok = ok and all(np.hypot(*(q - p)) > r + rq + clear for q, rq in zip(new_p, new_r))
         if ok:
@@ -62,6 +62,10 @@ class _Source:
             if self.radii is not None:
                 self.taken += 1
         return ok
+
+    def velocities(self, count):
+        """Initial velocities of ``count`` new grains: straight down at the inlet speed."""
+        return np.tile([0.0, -self.speed], (count, 1))
 
     def state(self):
         """What a checkpoint stores (besides the generator)."""
@@ -75,7 +79,8 @@ class _Source:
 class PointSource(_Source):
     """A localized source above the pile axis ``x = 0``: ``slots`` insertion sites in a
     row, ``drop_height_d`` mean diameters above the settled grains under it (so that
-    impacts stay gentle while the pile grows)."""
+    impacts stay gentle while the pile grows); ``source.rows`` (default 1) grains are
+    tried per site, stacked ``2.2 radius_max`` apart (a denser stream, same speed)."""
 
     def __init__(self, cfg, rng, y_ground, radii=None):
         s = cfg["source"]
@@ -84,15 +89,18 @@ class PointSource(_Source):
         super().__init__(cfg, rng, y_ground, 0.5 * s["slots"] * pitch, radii)
         self.slots = (np.arange(s["slots"]) - (s["slots"] - 1) / 2) * pitch
         self.half_width = self.half_span
+        self.rows, self.pitch = int(s.get("rows", 1)), pitch
 
     def draw(self, pos, radius, limit):
         """New grains at free sites (clearance ``0.05 d``): positions and radii."""
         new_p, new_r = [], []
         for x in self.slots[self.rng.permutation(len(self.slots))]:
-            if len(new_r) >= limit:
-                break
-            r = self._radius()
-            self._try(x + self.rng.uniform(-1, 1) * self.cfg["jitter_d"] * self.d, r, pos, radius, new_p, new_r)
+            for j in range(self.rows):
+                if len(new_r) >= limit:
+                    break
+                r = self._radius()
+                self._try(x + self.rng.uniform(-1, 1) * self.cfg["jitter_d"] * self.d, r, pos, radius, new_p, new_r,
+                          j * self.pitch)
         return np.array(new_p).reshape(-1, 2), np.array(new_r)
 
 
@@ -105,6 +113,15 @@ class RainSource(_Source):
             raise ValueError(f"rain half_width = {half_width!r} must be > 0")
         super().__init__(cfg, rng, y_ground, float(half_width), radii)
         self.half_width, self.sites = float(half_width), int(sites)
+        self.spread = cfg["rain"].get("spread", 0.0) * np.sqrt(cfg["gravity"] * self.d)
+
+    def velocities(self, count):
+        """Straight down at the inlet speed, plus a horizontal speed uniform in
+        ``± rain.spread sqrt(g d)`` (drawn after the positions; none when 0)."""
+        v = super().velocities(count)
+        if self.spread > 0:
+            v[:, 0] = self.rng.uniform(-self.spread, self.spread, count)
+        return v
 
     def draw(self, pos, radius, limit):
         new_p, new_r = [], []

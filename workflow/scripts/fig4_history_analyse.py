@@ -11,7 +11,11 @@ files = {}
 for path in snakemake.input.piles:  # noqa: F821
     ds = xr.load_dataset(path)
     files.setdefault(ds.attrs["history"], []).append(ds)
-out = history_analysis.ensemble_dataset(cfg, files)
+exact = {}
+for path in snakemake.input.exact:  # noqa: F821
+    e = xr.load_dataset(path)
+    exact[(e.attrs["history"], int(e.attrs["member"]))] = e
+out = history_analysis.ensemble_dataset(cfg, files, exact)
 out.attrs.update(provenance(cfg))
 write_dataset(out, snakemake.output[0])  # noqa: F821
 for h in out.history.values:
