@@ -95,7 +95,7 @@ def test_ground_pressure_maps_integrate_to_the_ground_force():
     scene = small_pile()
     c, H, F = balanced(scene)
     r = ExactSet(H, F, c.mu).minimize(np.zeros(2 * c.n))[1]
-    weight = float(scene.mass.sum() * 10.0)
+    weight = float(scene.mass[:scene.n_mobile].sum() * 10.0)
     x = np.linspace(-20, 20, 4001)
     K = pm.kernel_matrix(c, scene.n_mobile, x, 1.5)
     assert abs((K @ r).sum() * (x[1] - x[0]) - weight) <= 1e-9 * weight
@@ -109,3 +109,75 @@ def test_ground_pressure_maps_integrate_to_the_ground_force():
     assert pm.dip_verdict(-1.0, 0.5, -3.0, -0.2) == ("forced", True)
     assert pm.dip_verdict(-1.0, 1.5, -3.0, -0.2) == ("forced", False)
     assert pm.dip_verdict(-1.0, 0.1, -3.0, 0.2) == ("allowed", False)
+
+
+def three_grain_pile(mu):
+    """Two grains on three touching ground discs and one on top of them (radii 1)."""
+    h = np.sqrt(3.0)
+    ground = np.array([[-2.0, 0.0], [0.0, 0.0], [2.0, 0.0]])
+    pos = np.array([[-1.0, h], [1.0, h], [0.0, 2 * h]])
+    return ncd.make_scene(pos, np.ones(3), 1.0, obstacle_pos=ground, obstacle_radius=np.ones(3),
+                          gravity=(0.0, -10.0), mu=mu)
+
+
+def vertices_by_enumeration(H, F, mu):
+    """Every vertex of {r : H r + F = 0, |r_t| <= mu r_n}: in the null-space coordinates
+    r = r0 + Z y, each choice of d = dim Z Coulomb rows with an invertible system, kept
+    when it satisfies every row (brute force, no LP)."""
+    import itertools
+    H = np.asarray(H.todense() if hasattr(H, "todense") else H, float)
+    k = H.shape[1] // 2
+    G = np.zeros((3 * k, 2 * k))
+    for i in range(k):
+        G[i, 2 * i + 1], G[i, 2 * i] = 1.0, -mu[i]          # r_t - mu r_n <= 0
+        G[k + i, 2 * i + 1], G[k + i, 2 * i] = -1.0, -mu[i]  # -r_t - mu r_n <= 0
+        G[2 * k + i, 2 * i] = -1.0                          # -r_n <= 0
+    r0 = np.linalg.lstsq(H, -F, rcond=None)[0]
+    _, s, vt = np.linalg.svd(H)
+    Z = vt[int(np.sum(s > 1e-12 * s[0])):].T
+    Gz, b = G @ Z, -G @ r0
+    scale = np.abs(F).max()
+    out = []
+    for rows in itertools.combinations(range(len(G)), Z.shape[1]):
+        M = Gz[list(rows)]
+        if abs(np.linalg.det(M)) < 1e-10:
+            continue
+        y = np.linalg.solve(M, b[list(rows)])
+        if np.all(Gz @ y <= b + 1e-10 * scale):
+            out.append(r0 + Z @ y)
+    return np.array(out)
+
+
+def test_three_grain_pile_polygon_equals_the_hull_of_enumerated_vertices():
+    """A ∩ C of a three-grain pile (7 contacts, dimension 14 - 9 = 5) by vertex enumeration
+    (C(21, 5) row choices): the LP polygon of the left ground disc's force on grain 0 equals
+    the hull of the projected vertices, vertex for vertex, to 1e-9 of the weight."""
+    from scipy.spatial import ConvexHull
+    scene = three_grain_pile(0.3)
+    c, H, F = balanced(scene)
+    assert c.n == 7
+    weight = float(scene.mass[:scene.n_mobile].sum() * 10.0)
+    V = vertices_by_enumeration(H, F, c.mu)
+    assert len(V) >= 3
+    es = ExactSet(H, F, c.mu)
+    assert es.fp.is_bounded()
+    eq, co = es.fp.violations(V)
+    assert eq.max() <= 1e-12 and co.max() <= 1e-12
+    left = int(np.nonzero((c.body_a == 0) & (c.body_b == 3))[0][0])     # grain 0 on the left ground disc
+    L = np.zeros((2, 2 * c.n))
+    for row in (0, 1):
+        L[row, 2 * left], L[row, 2 * left + 1] = c.normal[left, row], c.tangent[left, row]
+    P = V @ L.T
+    hull = P[ConvexHull(P).vertices]
+    poly = es.polygon(L, n_dirs=16)
+    assert poly["exact"] and len(poly["vertices"]) == len(hull)
+    d = np.hypot(*(poly["vertices"][:, None] - hull[None]).transpose(2, 0, 1))
+    assert d.min(1).max() <= 1e-9 * weight and d.min(0).max() <= 1e-9 * weight
+    assert abs(poly["inner_area"] - ConvexHull(P).volume) <= 1e-9 * weight ** 2
+    # the exact range of the middle ground disc's vertical force on grain 0 equals the vertices' range
+    mid = int(np.nonzero((c.body_a == 0) & (c.body_b == 4))[0][0])
+    fy = np.zeros(2 * c.n)
+    fy[2 * mid], fy[2 * mid + 1] = c.normal[mid, 1], c.tangent[mid, 1]
+    lo, hi = es.interval(fy)
+    assert hi - lo > 1e-3 * weight
+    assert abs(lo - (V @ fy).min()) <= 1e-9 * weight and abs(hi - (V @ fy).max()) <= 1e-9 * weight

@@ -5,8 +5,10 @@ The equilibrium forces of the final arrangement form the polytope
 builds its scaled equations and Coulomb rows).  Every quantity of the figure is a
 linear map of ``r`` (cut resultants, ground forces), so its exact range over
 A ∩ C is given by linear programs.  :class:`ExactSet` keeps one sparse HiGHS
-model (``highspy``) and changes only its objective between queries, so that
-each LP restarts from the previous optimal basis:
+model (``highspy``) whose only rows are the equilibrium equations (the Coulomb
+sectors are column bounds, :func:`cone_columns`) and changes only its objective
+between queries, so that each LP restarts (primal simplex) from the previous
+optimal basis:
 
 * :meth:`ExactSet.polygon`: the exact projection of A ∩ C under a 2-row map
   (a cut resultant) -- ``n_dirs`` support directions evenly spread, then every
@@ -30,7 +32,8 @@ import xarray as xr
 
 from ..contacts import h_matrix
 from ..io import provenance
-from ..polytope import ForcePolytope, PolytopeError, polygon_area, support_polygon
+from ..polygon import hull_area, outside_distance, polygon_area, support_polygon
+from ..polytope import ForcePolytope, PolytopeError
 from . import cuts as cm
 
 FEAS_TOL = 1e-10
@@ -42,16 +45,16 @@ class ExactSet:
     def __init__(self, H, F, mu):
         self.fp = fp = ForcePolytope(H, F, mu)
         self.scale, self.n = fp.scale, 2 * fp.n_contacts
-        A = sp.vstack([fp.A_eq, fp.G]).tocsc()
-        m_ub = fp.G.shape[0]
+        self.T, upper = cone_columns(fp.mu)
+        self._Tt = self.T.T.tocsr()
+        A = (fp.A_eq @ self.T).tocsc()
         lp = highspy.HighsLp()
         lp.num_col_, lp.num_row_ = self.n, A.shape[0]
-        inf = highspy.kHighsInf
         lp.col_cost_ = np.zeros(self.n)
-        lp.col_lower_ = np.full(self.n, -inf)
-        lp.col_upper_ = np.full(self.n, inf)
-        lp.row_lower_ = np.concatenate([fp.b_eq, np.full(m_ub, -inf)])
-        lp.row_upper_ = np.concatenate([fp.b_eq, np.zeros(m_ub)])
+        lp.col_lower_ = np.zeros(self.n)
+        lp.col_upper_ = upper
+        lp.row_lower_ = fp.b_eq
+        lp.row_upper_ = fp.b_eq
         lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
         lp.a_matrix_.start_ = A.indptr
         lp.a_matrix_.index_ = A.indices
@@ -68,7 +71,7 @@ class ExactSet:
     def minimize(self, c):
         """``(min c . r, r)`` over A ∩ C (``c`` in force units, ``r`` forces)."""
         t0 = time.perf_counter()
-        self.highs.changeColsCost(self.n, self._cols, np.asarray(c, dtype=float) * self.scale)
+        self.highs.changeColsCost(self.n, self._cols, self._Tt @ np.asarray(c, dtype=float) * self.scale)
         self.highs.run()
         status = self.highs.getModelStatus()
         self.n_lp += 1
@@ -77,7 +80,7 @@ class ExactSet:
             raise PolytopeError("A ∩ C is empty: no contact forces balance the weights")
         if status != highspy.HighsModelStatus.kOptimal:
             raise PolytopeError(f"LP not solved: {self.highs.modelStatusToString(status)}")
-        r = np.asarray(self.highs.getSolution().col_value) * self.scale
+        r = self.T @ np.maximum(np.asarray(self.highs.getSolution().col_value), 0.0) * self.scale
         return float(np.dot(c, r)), r
 
     def interval(self, c):
@@ -122,10 +125,11 @@ class ExactSet:
         support points' full force vectors, one per LP).
         """
         L = sp.csr_matrix(L)
+        Lt = L.T.tocsr()
         full = []
 
         def query(u):
-            _, r = self.minimize(-(L.T @ u))
+            _, r = self.minimize(-(Lt @ u))
             full.append(r)
             return L @ r
 
@@ -133,6 +137,28 @@ class ExactSet:
         out = support_polygon(query, dirs, tol * self.scale, max_lp, self.scale)
         out["points"] = np.array(full)
         return out
+
+
+def cone_columns(mu):
+    """The Coulomb sectors as bounds: ``r = T y`` with ``y >= 0`` (``y <= upper``).
+
+    Per contact ``y = (a, b) = (mu r_n + r_t, mu r_n - r_t)``, so that ``|r_t| <= mu r_n``
+    is ``a, b >= 0`` (``r_n = (a + b) / (2 mu)``, ``r_t = (a - b) / 2``); a frictionless
+    contact has ``r_n = a``, ``r_t = 0`` (``b`` fixed at 0).  The LP then has only the
+    equilibrium rows, and every LP point satisfies Coulomb's law to round-off."""
+    mu = np.asarray(mu, dtype=float)
+    k = len(mu)
+    i = np.arange(k)
+    rough = mu > 0
+    inv = np.where(rough, 0.5 / np.where(rough, mu, 1.0), 1.0)
+    rows = np.concatenate([2 * i, 2 * i, 2 * i + 1, 2 * i + 1])
+    cols = np.concatenate([2 * i, 2 * i + 1, 2 * i, 2 * i + 1])
+    vals = np.concatenate([inv, np.where(rough, inv, 0.0), np.where(rough, 0.5, 0.0), np.where(rough, -0.5, 0.0)])
+    T = sp.csr_matrix((vals, (rows, cols)), shape=(2 * k, 2 * k))
+    T.eliminate_zeros()
+    upper = np.full(2 * k, highspy.kHighsInf)
+    upper[2 * i[~rough] + 1] = 0.0
+    return T, upper
 
 
 def _min_norm(K, r, eps=1e-12, refine=20):
@@ -164,7 +190,6 @@ def resultant_angle(vertices, outer):
     """Range of the angle below the horizontal (degrees, pointing outward) of the
     resultants of a convex polygon not containing the origin (nan, nan if it does)."""
     v = np.asarray(vertices, float).reshape(-1, 2)
-    from ..polytope import outside_distance
     if len(v) >= 3 and outside_distance(np.zeros((1, 2)), v)[0] == 0.0:
         return np.nan, np.nan
     phi = np.degrees(np.arctan2(-v[:, 1], outer * v[:, 0]))
@@ -218,7 +243,6 @@ def exact_dataset(cfg, construction, cuts, log=None):
     fy_max = np.array([v[:, 1].max() for v in polys])
     fy_min = np.array([v[:, 1].min() for v in polys])
     hist_F = (C @ history).reshape(-1, 2)
-    from ..polytope import outside_distance
     hist_out = np.array([outside_distance(hist_F[k:k + 1], polys[k])[0] for k in range(len(kind))])
     # (c) ground pressure: the bins of cuts.nc and a kernel average on a grid
     edges = np.append(cuts["bin_lo"].values, cuts["bin_hi"].values[-1])
@@ -297,7 +321,6 @@ def rest_mask(ens):
 def cloud_in_polygon(exact, ens, k, mask):
     """Points of cut ``k`` of the runs in ``mask``, their distance outside the exact
     polygon (N) and the coverage (cloud hull area / polygon area)."""
-    from ..polytope import hull_area, outside_distance
     P = np.column_stack([ens.cut_force_x.values[mask, k], ens.cut_force_y.values[mask, k]])
     poly = polygon_of(exact, k)
     out = outside_distance(P, poly) if len(P) else np.zeros(0)
