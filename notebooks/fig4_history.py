@@ -30,10 +30,14 @@
 # grains (same radii, inserted in the same order) on the *same* rough ground:
 #
 # 1. *point source*: Figure 4's construction (insertion sites above $x = 0$, a drop
-#    height that rises with the pile);
-# 2. *rain*: the grains dropped at positions uniform over $|x| \le$ the base
+#    height that rises with the pile), with a denser stream (grains stacked three
+#    high per site, same speed);
+# 2. *rain*: the grains dropped at positions uniform over $|x| \le L$, $L$ the base
 #    half-width of the member's point-source pile, from a height that rises with the
-#    deposit.
+#    deposit, onto a **finite base**: the member's ground discs with $|x| \le L$, as in
+#    the experiments (sand rained through a sieve onto a base of finite size). Grains
+#    that roll off the base edges are removed from the simulation once they have
+#    fallen below the base, and counted.
 #
 # Every pile is stepped until the warm equilibrium test of section 2 passes; its
 # forces are the history forces. Per pile: the ground stress profile (Gaussian kernel
@@ -84,13 +88,20 @@ P, R = s["point"], s["rain"]
 k = s["kernel"]
 display(Markdown(f"""
 **Shapes.** The point-source piles have a base half-width $L$ of {P['L']:.1f} mean diameters,
-an apex {P['apex']:.1f} d above the ground and flanks at {P['slope']:.1f}° on average. The rain
-falls over $|x| \\le L$ onto the same unbounded ground; the rained deposits are
-{R['apex']:.1f} d high with fitted flanks of {R['slope']:.1f}° and toes {R['fitL']:.1f} d from the
-axis: {'a layer spread beyond the rain, not a heap' if R['slope'] < 0.5 * P['slope'] else 'heaps'}.
-In the experiments the rain covers a base of finite size, off which the excess grains fall;
-that construction is not the one simulated here. Both histories are drawn against $x / L$
-with the $L$ of the member's point-source pile.
+an apex {P['apex']:.1f} d above the ground and flanks at {P['slope']:.1f}° on average
+(apex / ($L$ tan flank) = {P['cone']:.2f}: 1 for a cone). The rain falls over $|x| \\le L$ onto
+the finite base $|x| \\le L$; {R['removed']:.1f} of the {P['grains']:.0f} poured grains roll off
+its edges on average, so the rained piles hold {R['grains_min']} to {R['grains_max']} grains
+(the point-source piles {P['grains_min']} to {P['grains_max']}; the stresses are normalised by
+each pile's own weight). The rained deposits are {R['apex']:.1f} d high with fitted flanks of
+{R['slope']:.1f}° (apex / ($L$ tan flank) = {R['cone']:.2f}):
+{'a flat layer over the base with steep edges, not a heap with flanks at the angle of repose' if R['slope'] < 0.5 * P['slope'] else 'heaps'}.
+Grains rained gently (perfectly inelastic impacts, drop height {cfg['source']['drop_height_d']:g} d)
+stop where they land; a layer's edge of a few grains stands steeper than the flanks of a
+pile built by avalanches, so few grains roll off. The experiments' rain falls from higher,
+with bouncing grains; much faster impacts need a smaller time step here (the grains then
+overlap by more than the overlap tolerance within one step).
+Both histories are drawn against $x / L$ with the $L$ of the member's point-source pile.
 
 **Ground stress ({s['piles']} piles per history, kernel {k:g} d).** Dip depth of the
 mean profile: point source {P['dip']:.3f} (95 % band {P['lo']:.3f} to {P['hi']:.3f}),
@@ -118,3 +129,26 @@ and {R['dev_median']:.1f}° (rain) steeper than the flank (interquartile range
 {P['dev_iqr']:.1f}° and {R['dev_iqr']:.1f}°); it is steeper than the free surface at
 {100 * P['arching']:.0f} % and {100 * R['arching']:.0f} % of the cuts.
 """))
+
+# %% [markdown]
+# **Exact ranges (sections 4-5).** The history forces are one point of the set
+# $A \cap C$ of force states that balance every grain within the Coulomb cones. For
+# the first piles of each history the exact range of the cut resultant's angle over
+# that set is computed by linear programs (HiGHS; thin vertical lines in the arching
+# panel).
+
+# %%
+def exact_text(h):
+    x = s[h]
+    if "exact_piles" not in x:
+        return f"{hp.LABELS[h]}: no exact ranges computed."
+    return (f"{hp.LABELS[h]}, {x['exact_piles']} piles: the admissible angle at a cut spans "
+            f"{x['exact_width_median']:.1f}° on median (at most {x['exact_width_max']:.1f}°); every admissible "
+            f"state is steeper than the flank at {100 * x['exact_all_positive']:.0f} % of the cuts and every one "
+            f"shallower at {100 * x['exact_all_negative']:.0f} %; at {100 * x['exact_undefined']:.0f} % the "
+            f"admissible resultants surround zero (no angle range).")
+
+
+display(Markdown(" ".join(exact_text(h) for h in an.history.values)
+                 + " The arching angle of one force state is thus one choice among many: the spread of the "
+                   "history angles over piles is to be read against these ranges."))

@@ -99,6 +99,21 @@ def test_pile_at_rest_and_weight(uninterrupted):
     assert np.isnan(ds.frame_x.values[0]).any()
 
 
+def test_pile_file_exports_its_frames(uninterrupted, tmp_path):
+    """fig4_history_point/rain of `snakemake export`: a pile file's frames to VTK."""
+    import meshio
+    from ncd.export import write_vtk
+    cfg, (scene, rec, ground, eq, frames) = uninterrupted
+    ds = history.pile_dataset(cfg, "point", 3, scene, rec, ground, eq, frames)
+    discs, ground_file = write_vtk(ds, tmp_path, "point")
+    last = meshio.read(tmp_path / f"point_discs_{ds.sizes['frame'] - 1:04d}.vtu")
+    np.testing.assert_array_equal(last.points[:, 0], ds.x.values)      # the final state, every grain
+    np.testing.assert_array_equal(last.point_data["radius"], ds.radius.values)
+    first = meshio.read(tmp_path / "point_discs_0000.vtu")
+    assert 0 < len(first.points) < ds.sizes["grain"]                  # grains still to pour left out
+    assert len(meshio.read(ground_file).points) == ds.sizes["ground"]
+
+
 def test_rain_source_and_same_grains():
     cfg = small_cfg(30)
     r1, r2 = history.grain_radii(cfg, 5), history.grain_radii(cfg, 5)
@@ -111,6 +126,51 @@ def test_rain_source_and_same_grains():
         history.construct(cfg, "rain", 0)
     with pytest.raises(ValueError, match="history"):
         history.construct(cfg, "sieve", 0)
+
+
+def test_removing_grains_keeps_the_warm_start_of_the_others(uninterrupted):
+    cfg, (scene, rec, ground, eq, frames) = uninterrupted
+    from ncd.contacts import detect_contacts, match_warm
+    factory = lambda p, r, v, w, a: history.pile_scene(cfg, p, r, *ground, vel=v, spin=w, angle=a)  # noqa: E731
+    nm = scene.n_mobile
+    old = detect_contacts(scene, alert=1e-9 * scene.radius.min())
+    assert np.array_equal(old.key, scene.prev_keys)
+    gone = int(np.argmax(np.bincount(old.body_a, minlength=nm)))       # the grain with most contacts
+    keep = np.arange(nm) != gone
+    new = construction.remove_grains(scene, keep, factory)
+    assert new.n_mobile == nm - 1 and new.time == scene.time
+    c = detect_contacts(new, alert=1e-9 * new.radius.min())
+    guess = match_warm(c, new.prev_keys, new.prev_impulse)
+    new_index = np.where(keep, np.cumsum(keep) - 1, -1)
+    stay = (old.body_a != gone) & (old.body_b != gone)
+    a = new_index[old.body_a[stay]]
+    b = np.where(old.body_b[stay] < nm, new_index[np.minimum(old.body_b[stay], nm - 1)], old.body_b[stay] - 1)
+    # every remaining contact finds its old impulse, the removed grain's contacts are gone
+    assert len(new.prev_keys) == stay.sum() == c.n
+    for ai, bi, imp in zip(a, b, scene.prev_impulse[stay]):
+        j = np.nonzero((c.body_a == ai) & (c.body_b == bi))[0]
+        assert len(j) == 1 and np.array_equal(guess[j[0]], imp)
+
+
+def test_rain_on_a_finite_base_removes_the_grains_that_fall_off():
+    cfg = small_cfg(40)
+    cfg["surface"]["fit_range"] = [0.0, 1.0]      # a flank fit on a deposit a few grains high
+    d = history.mean_diameter(cfg)
+    info = {}
+    L = 5.0 * d                                   # a base too narrow for 40 grains
+    scene, rec, ground, eq, frames = history.construct(cfg, "rain", 2, L, info=info)
+    ds = history.pile_dataset(cfg, "rain", 2, scene, rec, ground, eq, frames, L, info)
+    assert eq.at_rest
+    assert np.all(np.abs(ground[0][:, 0]) <= L) and ds.sizes["ground"] < 12
+    assert ds.attrs["n_removed"] > 0 and ds.sizes["grain"] + ds.attrs["n_removed"] == 40
+    assert ds.attrs["n_removed_left"] + ds.attrs["n_removed_right"] == ds.attrs["n_removed"]
+    # the grains left are poured grains of the member's sequence, all standing on the base
+    idx = ds.poured_index.values
+    assert len(np.unique(idx)) == len(idx) and idx.max() < 40
+    np.testing.assert_array_equal(ds.radius.values, history.grain_radii(cfg, 2)[idx])
+    assert np.all(np.abs(ds.x.values) <= ds.attrs["base_edge"]) and np.all(ds.y.values > 0)
+    x, fx, fy = history.ground_forces(ds)
+    assert abs(fy.sum() / ds.attrs["weight"] - 1) < WEIGHT_TOL
 
 
 def test_profile_and_dip_by_hand():
@@ -165,9 +225,33 @@ def test_histories_use_the_same_grains(piles):
     assert len(members) >= 2
     for m in members:
         p, r = by[("point", m)], by[("rain", m)]
-        assert p.sizes["grain"] == r.sizes["grain"]
-        assert np.array_equal(p.radius.values, r.radius.values)   # same grains, same insertion order
-        assert np.array_equal(p.ground_radius.values, r.ground_radius.values)
+        n = p.sizes["grain"]
+        # both poured the same grains in the same order; the rain's grains that rolled off its
+        # finite base are counted, those left are the point pile's grains of the same index
+        assert p.attrs["n_poured"] == r.attrs["n_poured"] == n and p.attrs["n_removed"] == 0
+        assert r.sizes["grain"] + r.attrs["n_removed"] == n
+        np.testing.assert_array_equal(p.poured_index.values, np.arange(n))
+        np.testing.assert_array_equal(r.radius.values, p.radius.values[r.poured_index.values])
+        # the rain's base is the member's ground cut at the point pile's base half-width
+        L = r.attrs["point_half_width"]
+        assert L == p.attrs["base_half_width"]
+        inside = np.abs(p.ground_x.values) <= L
+        np.testing.assert_array_equal(r.ground_radius.values, p.ground_radius.values[inside])
+        assert np.all(np.abs(r.x.values) <= r.attrs["base_edge"])
+
+
+def test_exact_ranges_contain_the_history_angle(analysis, results):
+    cfg = yaml.safe_load(analysis.attrs["config_yaml"])
+    done = analysis.exact_computed.values
+    assert done.sum() == 2 * min(cfg["exact"]["piles"], cfg["piles"]) and done[:, 0].all()
+    e = analysis.where(analysis.exact_computed == 1, drop=True)
+    lo, hi, dev = e.exact_deviation_min.values, e.exact_deviation_max.values, e.cut_deviation.values
+    ok = np.isfinite(lo)
+    assert ok.mean() > 0.5
+    # the history angle is one admissible angle: inside the exact range (LP tolerance ~1e-9 of the forces)
+    assert np.all(lo[ok] <= dev[ok] + 1e-5) and np.all(dev[ok] <= hi[ok] + 1e-5)
+    scale = float(analysis.weight.max())
+    assert float(np.nanmax(e.exact_history_outside.values)) < 1e-6 * scale
 
 
 def test_bands_are_over_piles(analysis, piles, results):

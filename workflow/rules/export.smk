@@ -1,7 +1,8 @@
 # ParaView and animation output (ncd/export.py): `snakemake -j2 export`, not part of the
 # default target.  For each figure whose data file stores frames (fig2_slope: the flow,
 # every `flow.snapshot_every` steps; fig4_pile: the pile's construction, every
-# `construction.frame_every` steps, with the ground discs in <name>_ground.vtu):
+# `construction.frame_every` steps, with the ground discs in <name>_ground.vtu; fig4_history:
+# pile 0 of each history, as fig4_history_point and fig4_history_rain):
 #   results/<figure>/vtk/<name>_discs.pvd, <name>_contacts.pvd (+ one .vtu per frame)
 #   results/figures/<figure>.mp4  (animated .gif instead when ffmpeg is absent)
 import shutil
@@ -11,6 +12,8 @@ ANIM_EXT = "mp4" if shutil.which("ffmpeg") else "gif"
 EXPORTS = {f: v for f, v in {"fig2_slope": ("results/fig2_slope/trajectory.nc", "flow"),
                              "fig4_pile": ("results/fig4_pile/construction.nc", "construction")}.items()
            if f in FIGURES}
+if "fig4_history" in FIGURES:
+    EXPORTS.update({f"fig4_history_{h}": (f"{FH}/piles/n{NH}/{h}_000.nc", h) for h in ("point", "rain")})
 
 
 rule export_frames:

@@ -60,7 +60,7 @@ rule fig4_history_exact:
         member=r"\d+",
         n=r"\d+",
     params:
-        config=CFGH,
+        config={k: v for k, v in CFGH.items() if k != "piles"},   # one pile's ranges: not the pile count
     log:
         log(FIGH, "exact_n{n}_{history}_{member}"),
     benchmark:
