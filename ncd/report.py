@@ -222,6 +222,35 @@ def fig4_dip(results):
                     REPRODUCED if dip else DIFFERS, "ground pressure under the apex below its neighbours'")
 
 
+def _history_analysis(results):
+    """The ensemble analysis of fig4_history with the smallest pile size (the default 10^3)."""
+    paths = sorted(Path(results).glob("fig4_history/analysis_n*.nc"), key=lambda q: int(q.stem.split("_n")[-1]))
+    if not paths:
+        raise FileNotFoundError("fig4_history/analysis_n*.nc absent")
+    return xr.load_dataset(paths[0])
+
+
+def fig4_history_dip(results):
+    an = _history_analysis(results)
+    s = an.isel(kernel=0)
+    p, r = s.sel(history="point"), s.sel(history="rain")
+    lo, hi = float(p.dip_lo), float(p.dip_hi)
+    return Measured(f"dip of the mean profile over {an.sizes['pile']} point-source piles {float(p.dip_mean):.3f} "
+                    f"[{lo:.3f}, {hi:.3f}] (rain {float(r.dip_mean):.3f}; difference p = {float(s.dip_diff_p):.2g})",
+                    REPRODUCED if lo > 0 else DIFFERS,
+                    "95 % bootstrap band over piles of the point-source dip depth above 0")
+
+
+def fig4_history_arching(results):
+    an = _history_analysis(results)
+    p = an.sel(history="point")
+    med = float(p.cut_deviation.median())
+    lo, hi = float(p.deviation_median_lo.min()), float(p.deviation_median_hi.max())
+    return Measured(f"cut resultant minus flank slope over {an.sizes['pile']} point-source piles: median {med:.1f}° "
+                    f"(bootstrap bands of the per-cut medians within [{lo:.1f}°, {hi:.1f}°])",
+                    REPRODUCED if abs(med) <= 10 else DIFFERS, "median deviation within 10° of the free surface")
+
+
 CLAIMS = [
     Claim("fig1_wedged", "§1, Fig. 1", "a possible evolution consists in B losing contact and falling freely. "
           "But, if the friction angle γ is large enough, B may also remain wedged.", fig1_two_evolutions),
@@ -249,6 +278,10 @@ CLAIMS = [
           "the segment.", fig4_contacts),
     Claim("fig4_pile", "§5", "A local minimum of pressure may even be found at the vertical of the apex.",
           fig4_dip),
+    Claim("fig4_history", "§5", "A local minimum of pressure may even be found at the vertical of the apex.",
+          fig4_history_dip),
+    Claim("fig4_history", "§5", "The vector obtained, approximately parallel to the free surface, confirms the "
+          "arching trend of force transmission throughout the lateral bank.", fig4_history_arching),
 ]
 
 

@@ -248,8 +248,11 @@ def test_exact_ranges_contain_the_history_angle(analysis, results):
     lo, hi, dev = e.exact_deviation_min.values, e.exact_deviation_max.values, e.cut_deviation.values
     ok = np.isfinite(lo)
     assert ok.mean() > 0.5
-    # the history angle is one admissible angle: inside the exact range (LP tolerance ~1e-9 of the forces)
-    assert np.all(lo[ok] <= dev[ok] + 1e-5) and np.all(dev[ok] <= hi[ok] + 1e-5)
+    # the history angle is one admissible angle: inside the exact range (LP tolerance ~1e-9 of the forces),
+    # angles compared modulo 360 degrees
+    above = (dev[ok] - lo[ok] + 1e-5) % 360.0
+    assert np.all(above <= hi[ok] - lo[ok] + 2e-5)
+    assert np.all(lo[ok] > -180.0 - 1e-9) and np.all(lo[ok] <= 180.0) and np.all(hi[ok] >= lo[ok])
     scale = float(analysis.weight.max())
     assert float(np.nanmax(e.exact_history_outside.values)) < 1e-6 * scale
 

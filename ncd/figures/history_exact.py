@@ -57,6 +57,9 @@ def exact_ranges(cfg, ds, log=None):
                  es.n_lp, time.perf_counter() - t0)
     shape = (2, -1)
     fq = ("flank", "cut_position")
+    # deviations from the flank slope, the lower end wrapped to (-180, 180] as the analysis' deviations
+    dev_lo = (np.asarray(amin) - slope + 180.0) % 360.0 - 180.0
+    dev_hi = dev_lo + (np.asarray(amax) - np.asarray(amin))
     q = np.asarray(cfg["analysis"]["cut_positions"], float)
     out = xr.Dataset(
         {
@@ -64,9 +67,9 @@ def exact_ranges(cfg, ds, log=None):
                                 "smallest angle below the horizontal (outward) of an admissible cut resultant"}),
             "exact_angle_max": (fq, np.reshape(amax, shape), {"units": "degree", "long_name":
                                 "largest angle below the horizontal (outward) of an admissible cut resultant"}),
-            "exact_deviation_min": (fq, np.reshape(amin, shape) - slope.reshape(shape), {"units": "degree",
+            "exact_deviation_min": (fq, dev_lo.reshape(shape), {"units": "degree",
                                     "long_name": "smallest admissible angle minus the flank slope"}),
-            "exact_deviation_max": (fq, np.reshape(amax, shape) - slope.reshape(shape), {"units": "degree",
+            "exact_deviation_max": (fq, dev_hi.reshape(shape), {"units": "degree",
                                     "long_name": "largest admissible angle minus the flank slope"}),
             "history_angle": (fq, phi_hist.reshape(shape), {"units": "degree", "long_name":
                               "angle of the history forces' cut resultant"}),
