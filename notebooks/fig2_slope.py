@@ -201,13 +201,14 @@ print(f"\nVERDICT: {verdict}.  zero-guess spread: min over the last {an['decades
       f"zero/warm at {tight:.0e}: {meas.attrs['verdict_zero_over_warm']:.3g}")
 
 # %% [markdown]
-# ## Distinct solutions, and why the dispersion is a line
+# ## Distinct solutions reached by NLGS, and where they differ
 #
 # At the tightest tolerance the runs of both ensembles are grouped into
 # *distinct solutions*: runs whose whole acceleration fields (all grains) agree
 # within `analysis.solution_threshold` $|g|$. If the runs reach only a few
-# isolated solutions, a grain's cloud consists of a few points; with two
-# solutions it is exactly a segment — a line of rank one, whatever the grain.
+# isolated solutions, a grain's cloud consists of a few points (plus the
+# iteration error left at the tolerance); with two solutions it is a segment.
+# Whether that is what happens here is measured below and by the census.
 # The contacts whose status (no contact / stick / slide) differs between the
 # two most frequent solutions tell where the alternative is decided, and the
 # network of contacts that *stick in both solutions* shows how the difference
@@ -399,15 +400,22 @@ save(fig, out, dpi=150)
 # NLGS end points say which solutions NLGS reaches, not how many the step has.
 # `census.nc` gathers exact solutions from the NLGS end points (zero-guess,
 # warm-start and random-guess runs), from Lemke's pivoting method on the LCP
-# form of the step (size $3\kappa$, several covering vectors) and from the
-# enumeration of contact-status patterns on the contacts that switch between
-# the solutions found; each is polished on its statuses to a residual of
-# $10^{-12}$, counted by basin (how many runs end on it) and restarted from a
-# $10^{-9}$ perturbation to see whether NLGS returns to it.
+# form of the step (size $3\kappa$, several covering vectors) and from
+# contact-status patterns that combine the status changes seen between any two
+# solutions found (clusters of switching contacts sharing a grain, each taking
+# the statuses of one solution or any combination of the statuses seen at its
+# contacts), round after round while new solutions appear; each is polished on
+# its statuses to a residual of $10^{-12}$, counted by basin (how many runs end
+# on it) and restarted from a $10^{-9}$ perturbation to see whether NLGS
+# returns to it. The chosen grain's cloud at the tightest tolerance is then
+# read through the census: which solutions its runs sit on, and how far from
+# them (the iteration error left).
 
 # %%
 census = xr.load_dataset(inp.census)
-Markdown(cs.census_text(census))
+cloud = cs.cloud_against_census(ens, census, grain, "zero")
+Markdown(cs.census_text(census) + "\n\n**The chosen grain's cloud, read through the census.** "
+         + cs.cloud_text(cloud, grain, tight, an["line_ratio"]))
 
 # %% [markdown]
 # ## What we measured, and where the reproduction differs
@@ -460,16 +468,17 @@ seg_angle = (f" against {np.degrees(np.arctan2(u[1], u[0])):.1f}° for the segme
              if meas.attrs["n_solutions"] >= 2 else "")
 Markdown(f"""
 * **Dispersion against tolerance: {verdict}.** The zero-guess spread of the chosen grain (grain {grain}) lies
-  in {min(zs):.3g}–{max(zs):.3g} m/s² ({min(zs) / g:.2f}–{max(zs) / g:.2f} $g$) at every tolerance from
+  in {min(zs):.3g}–{max(zs):.3g} m/s² ({min(zs) / g:.2g}–{max(zs) / g:.2g} $g$) at every tolerance from
   {window.max():.0e} to {tight:.0e}, while the warm-start spread goes from {ws[sorted(tols)[-2]]:.2g} m/s² at
   {sorted(tols)[-2]:.0e} to {ws[tight]:.2g} m/s² at {tight:.0e} (zero/warm {meas.attrs['verdict_zero_over_warm']:.3g}).
   Converged at {tight:.0e}: {', '.join(f'{i} {conv_t[i]}/{n_runs[i]}' for i in conv_t)}; median sweeps
   {', '.join(f'{i} {sw_med[i]:.0f} (max {sw_max[i]:.0f})' for i in sw_med)}. The flow itself stopped
   {int((traj.converged == 0).sum())} of its {traj.sizes['step']} steps at its {fl['solver']['max_sweeps']}-sweep
   budget (tolerance {fl['solver']['tol']:g}).{scan_text}
-* **NLGS end points.** At {tight:.0e} the converged runs reach {meas.attrs['n_solutions']} distinct solution(s)
-  ({sol_text}); the chosen grain's cloud has minor/major {float(sel.ratio.sel(init='zero', tol=tight)):.1e}, and
-  {vis_text}. The census above counts the exact solutions of the step.
+* **NLGS end points and the census.** At {tight:.0e} the converged runs reach {meas.attrs['n_solutions']}
+  distinct solution(s) ({sol_text}); {vis_text}. The step has {census.sizes['solution']} distinct exact
+  solutions in the census (NLGS reaches {int((census.n_zero + census.n_warm + census.n_random > 0).sum())} of
+  them). {cs.cloud_text(cloud, grain, tight, an['line_ratio'])}
 * **Loose tolerances.** At {loose:.0e} the chosen grain's major axes lie at {float(zero_l.angle):.0f}° (zero
   guess) and {float(warm_l.angle):.0f}° (warm start){seg_angle}; minor/major {float(zero_l.ratio):.2g} and
   {float(warm_l.ratio):.2g}; spreads {float(zero_l.spread):.2g} and {float(warm_l.spread):.2g} m/s²; visible
@@ -480,7 +489,8 @@ Markdown(f"""
   ({sc['width_diameters']} d wide), the rough ground, the deposit, the time step and the investigated step
   ({float(traj.attrs['investigated_time']) * 1e3:.0f} ms after the release, mean velocity
   {float(traj.mean_vx[k_step - 1]):.2g} m/s, accelerating at {slope_fit:.2g} m/s²) are ours; the paper gives none of
-  them. Its figure shows a line of many points; at convergence our NLGS runs reach a few end points, and a
-  filled line only for runs stopped at a loose tolerance, so the points *inside* the paper's line may be runs
-  stopped before convergence, while the line itself joins distinct solutions.
+  them. Its figure shows a line of many points; at {tight:.0e} our zero-guess runs sit on
+  {len(cloud['visited'])} exact solution(s) of the census, within {cloud['max_offset'] / g:.1e} $g$, and spread
+  along a filled cloud only when stopped at a loose tolerance ({float(zero_l.spread) / g:.2g} $g$ at {loose:.0e}):
+  points *inside* a line, if any, are runs stopped before convergence.
 """)

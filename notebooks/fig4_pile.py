@@ -82,6 +82,7 @@ from IPython.display import Markdown
 
 from ncd.figures import cuts as cm
 from ncd.figures import pile_exact as pe
+from ncd.figures import pressure as pm
 
 from ncd.notebook import paths, save
 
@@ -312,10 +313,12 @@ if len(p_run):
                     label="zero-guess runs (range)")
 ax.step(xb, p_hist, where="mid", color="k", lw=1.2, label="history")
 ax.step(xb, col, where="mid", color="tab:orange", ls="--", lw=1, label="weight of the column above")
+pm.draw_exact_band(ax, exact, d)
 ax.set_xlabel("x / d")
 ax.set_ylabel("vertical ground force per length (N/m)")
 ax.legend(fontsize=7)
-ax.set_title(f"(d) ground pressure, bins of {cfg['pressure']['bin_d']:g} d", fontsize=9)
+ax.set_title(f"(d) ground pressure: bins of {cfg['pressure']['bin_d']:g} d ({conv.sum()} rest runs), "
+             "kernel of the ground contacts", fontsize=9)
 
 # (e) tolerance study
 ax = fig.add_subplot(gs[2, 0])

@@ -1,7 +1,7 @@
 """Figure 2, exactly: a census of the solutions of the investigated step (Moreau 2005, section 3).
 
 NLGS from the zero guess reaches a few end points; that does not say how many
-solutions the step has.  The census gathers exact solutions from four sources,
+solutions the step has.  The census gathers exact solutions from three sources,
 each polished on its contact statuses to a relative natural-map residual
 ``<= polish_tol`` (:func:`ncd.finish.project_statuses`, minimum-norm correction):
 
@@ -9,13 +9,17 @@ each polished on its contact statuses to a relative natural-map residual
   warm-start runs at the tightest tolerance) and of ``random_runs`` NLGS runs
   from random guesses;
 * ``lemke``: Lemke's method (:mod:`ncd.lcp`) on the LCP form of the step (size
-  ``3 kappa``), with the covering vector ``1`` and ``lemke_runs - 1`` random ones
-  (each covering vector follows its own complementary path);
-* ``enumeration``: on the contacts whose status differs between two solutions
-  found, every combination of their two statuses (when there are at most
-  ``max_patterns``), and the combinations of the changes from one solution to
-  two others (:func:`enumerate_statuses`), each solved on its statuses and kept
-  when the result satisfies the contact law.
+  ``3 kappa``), with the covering vector ``1`` and ``lemke_runs - 1`` random ones,
+  log-uniform over ``± lemke_decades`` decades (each follows its own
+  complementary path);
+* ``enumeration``: the contacts whose status differs between any two solutions
+  found, grouped into clusters that share a grain; each cluster takes the
+  statuses of one solution or, when small, any combination of the statuses seen
+  at its contacts; all combinations up to ``max_patterns``, else every
+  single-cluster change of every solution plus seeded random combinations
+  (:func:`ncd.figures.slope_analysis.status_patterns`).  Each pattern is solved on its statuses, polished
+  and kept when exact; repeated while new solutions appear
+  (:func:`enumerate_statuses`, at most ``enumeration_rounds``).
 
 Solutions are distinct when their acceleration fields differ by more than
 ``same_tol |g|``.  Per solution: its basin (how many zero-guess, warm-start and
@@ -23,7 +27,6 @@ random-guess runs end within ``basin_tol |g|`` of it) and its stability (NLGS
 restarted from it plus a relative perturbation ``noise``, ``perturb_runs`` times,
 returns to it within ``basin_tol``).
 """
-import itertools
 import time
 
 import numpy as np
@@ -36,6 +39,7 @@ from ..lcp import frictional_lcp, impulse_of_lcp, lemke
 from ..local_solver import STICK, SLIDE_BACKWARD
 from ..nlgs import SolverSettings
 from ..stepper import prepare_step, solve_problem
+from .slope_analysis import status_patterns, switching_contacts
 
 METHODS = ("nlgs", "lemke", "enumeration")
 
@@ -122,45 +126,31 @@ class Census:
         return out
 
 
-def _try(step, census, base, status, ptol):
-    s = project_statuses(step.W, step.q.ravel(), step.mu, base, status.astype(np.int8))
-    return census.add(s, "enumeration", ptol) if step.residual(s) <= 1e-8 else -1
-
-
-def enumerate_statuses(step, census, max_patterns, ptol, rounds=2):
-    """Solve the step on status patterns built from the solutions found; yields the
-    census index of each pattern's solution (-1: the pattern gives none).
-
-    For every ordered pair ``(i, j)`` of solutions whose statuses differ at ``k``
-    contacts with ``2^k <= max_patterns``: the ``2^k`` patterns taking at each of
-    those contacts the status of ``i`` or of ``j``, from ``i``'s impulses.  Then,
-    for every solution ``i`` and pair ``j < k``, the pattern combining the status
-    changes from ``i`` to ``j`` and from ``i`` to ``k``.  Repeated for ``rounds``
-    while new solutions appear."""
-    done = set()
+def enumerate_statuses(step, census, max_patterns, ptol, rng, rounds=4, gate=1e-3):
+    """Solve the step on the patterns of :func:`status_patterns`, round after round
+    while new solutions appear.  Each pattern is solved on its statuses (minimum-norm
+    projection from the solution nearest in status) and, when the result's residual
+    is at most ``gate``, polished (statuses re-read) and added if exact.  Returns
+    ``(census indices per pattern (-1: none), switching contacts of the first round,
+    patterns per round, clusters per round)``."""
+    found, first_sw, n_per_round, n_clusters, tried = [], None, [], [], set()
+    contacts = step.problem.contacts
     for _ in range(rounds):
         n0 = len(census.impulse)
-        st = [step.status(s) for s in census.impulse]
-        for i in range(n0):
-            for j in range(n0):
-                sw = np.nonzero(st[i] != st[j])[0]
-                if i == j or (i, j) in done or 2 ** len(sw) > max_patterns:
-                    continue
-                done.add((i, j))
-                for bits in itertools.product((False, True), repeat=len(sw)):
-                    status = st[i].copy()
-                    status[sw] = np.where(bits, st[j][sw], st[i][sw])
-                    yield _try(step, census, census.impulse[i], status, ptol)
-            for j, k in itertools.combinations([m for m in range(n0) if m != i], 2):
-                if (i, j, k) in done:
-                    continue
-                done.add((i, j, k))
-                status = st[i].copy()
-                for m in (j, k):
-                    status[st[m] != st[i]] = st[m][st[m] != st[i]]
-                yield _try(step, census, census.impulse[i], status, ptol)
+        st = np.array([step.status(s) for s in census.impulse], np.int8)
+        pats, sw, ncl = status_patterns(st, contacts, step.nm, max_patterns, rng)
+        first_sw = sw if first_sw is None else first_sw
+        pats = [p for p in pats if p.tobytes() not in tried]
+        n_per_round.append(len(pats))
+        n_clusters.append(ncl)
+        for p in pats:
+            tried.add(p.tobytes())
+            base = int(np.argmin((st[:, sw] != p[sw]).sum(1)))
+            s = project_statuses(step.W, step.q.ravel(), step.mu, census.impulse[base], p)
+            found.append(census.add(s, "enumeration", ptol) if step.residual(s) <= gate else -1)
         if len(census.impulse) == n0:
             break
+    return found, (first_sw if first_sw is not None else np.zeros(0, np.int64)), n_per_round, n_clusters
 
 
 def nlgs_end_points(ens, measures):
@@ -201,7 +191,8 @@ def run_census(traj, ens, measures, cfg, log=None):
     M, b = frictional_lcp(step.W.toarray(), step.q, step.mu)
     lemke_info = []
     for j in range(cc["lemke_runs"]):
-        d = np.ones(len(b)) if j == 0 else np.random.default_rng((j, cc["root_seed"])).uniform(0.5, 1.5, len(b))
+        d = np.ones(len(b)) if j == 0 else 10.0 ** np.random.default_rng((j, cc["root_seed"])).uniform(
+            -cc["lemke_decades"], cc["lemke_decades"], len(b))
         x, info = lemke(M, b, covering=d)
         lemke_info.append(info)
         k = census.add(impulse_of_lcp(x, step.mu), "lemke", ptol) if x is not None else -1
@@ -211,15 +202,12 @@ def run_census(traj, ens, measures, cfg, log=None):
             log.info("Lemke %d: %s after %d pivots, LCP residual %.2g -> solution %d", j, info["status"],
                      info["pivots"], info["residual"], k)
     times["lemke"] = time.perf_counter() - t0
-    # status enumeration on the contacts that switch between the solutions found
+    # status patterns combining the changes between the solutions found
     t0 = time.perf_counter()
-    switching = np.nonzero((np.array([step.status(s) for s in census.impulse]) != step.status(census.impulse[0]))
-                           .any(0))[0]
-    n_patterns = 0
-    for k in enumerate_statuses(step, census, cc["max_patterns"], ptol):
-        n_patterns += 1
-        if k >= 0:
-            per_method["enumeration"].add(k)
+    found, switching, n_patterns, n_clusters = enumerate_statuses(
+        step, census, cc["max_patterns"], ptol, np.random.default_rng((cc["root_seed"], 1)),
+        rounds=cc["enumeration_rounds"], gate=cc["pattern_gate"])
+    per_method["enumeration"].update(k for k in found if k >= 0)
     times["enumeration"] = time.perf_counter() - t0
     # basins: the ensemble's runs and the random-guess runs
     tight = ens.isel(tol=-1)
@@ -252,7 +240,9 @@ def run_census(traj, ens, measures, cfg, log=None):
     checks = [check_solution(s, step.U(s), step.mu) for s in census.impulse]
     return {"step": step, "census": census, "per_method": per_method, "label_ens": label_ens, "ok_ens": ok_ens,
             "label_rnd": label_rnd, "returns": returns, "segment_t": seg_t, "segment_residual": seg,
-            "segment_pair": pair, "switching": switching, "n_patterns": n_patterns, "lemke_info": lemke_info,
+            "segment_pair": pair, "switching": switching_contacts([step.status(s) for s in census.impulse]),
+            "switching_before": switching, "n_patterns": n_patterns, "n_clusters": n_clusters,
+            "lemke_info": lemke_info,
             "checks": checks, "times": times, "random_scale": s_scale,
             "statuses": np.array([step.status(s) for s in census.impulse])}
 
@@ -298,13 +288,16 @@ def census_dataset(traj, ens, measures, cfg, log=None):
             "n_grains_differ": ("solution", (np.hypot(*(A - A[:1]).transpose(2, 0, 1)) > cc["grain_differ"] * step.g).sum(1) if n else np.zeros(0, int),
                                 {"units": "1", "long_name": f"grains whose acceleration differs from solution 0 by more than {cc['grain_differ']} |g|"}),
             "segment_residual": ("segment_t", out["segment_residual"], {"units": "1", "long_name": "residual of (1-t) s_a + t s_b between the two most visited NLGS solutions"}),
-            "switching": ("switching_contact", out["switching"], {"units": "1", "long_name": "contacts whose status differs between the solutions found before enumeration"}),
+            "switching": ("switching_contact", out["switching"], {"units": "1", "long_name": "contacts whose status differs between two of the solutions"}),
         },
         coords={"solution": np.arange(n), "disc": np.arange(step.nm), "contact": np.arange(step.problem.contacts.n),
                 "segment_t": out["segment_t"], "switching_contact": np.arange(len(out["switching"]))},
         attrs=provenance(cfg["census"], grain=grain, g=step.g, n_solutions=n,
                          **{f"n_{m}": len(out["per_method"][m]) for m in METHODS},
-                         n_patterns=out["n_patterns"], segment_pair=out["segment_pair"].astype(np.int64),
+                         n_patterns=int(sum(out["n_patterns"])),
+                         patterns_per_round=np.array(out["n_patterns"], np.int64),
+                         clusters_per_round=np.array(out["n_clusters"], np.int64),
+                         n_switching_before=len(out["switching_before"]), segment_pair=out["segment_pair"].astype(np.int64),
                          random_guess_scale=out["random_scale"],
                          random_converged=int((out["label_rnd"] != -2).sum()),
                          lemke_status="; ".join(f"{i['status']} after {i['pivots']} pivots" for i in out["lemke_info"])),
@@ -315,9 +308,68 @@ def census_dataset(traj, ens, measures, cfg, log=None):
         ds[k].attrs.update(units=u, long_name=ln)
     if log is not None:
         log.info("census: %d distinct solutions (nlgs %d, lemke %d, enumeration %d; %d patterns), seconds %s",
-                 n, *(len(out["per_method"][m]) for m in METHODS), out["n_patterns"],
+                 n, *(len(out["per_method"][m]) for m in METHODS), sum(out["n_patterns"]),
                  {k: round(v, 1) for k, v in out["times"].items()})
     return ds
+
+
+def cloud_against_census(ens, census, grain, init="zero"):
+    """The chosen grain's cloud at the tightest tolerance, read through the census.
+
+    Every converged ``init`` run is labelled with the census solution whose whole
+    acceleration field lies within ``basin_tol |g|`` of its own (-1: none).  With
+    ``X`` the runs' accelerations of ``grain`` and ``Y`` those of their solutions,
+    ``E = X - Y``: the principal axes (RMS extents) of the cloud ``X`` differ from
+    those of ``Y`` by at most ``rms(E)`` (singular values are 1-Lipschitz in the
+    Frobenius norm), so the cloud is a set of solutions with the shape of ``Y``
+    (one point, a segment for two solutions, ...) blurred by the iteration error
+    ``E``.  Returns a dict of counts and axes (m s-2)."""
+    from .slope_analysis import cloud_stats
+    tight = ens.sel(init=init).isel(tol=-1)
+    ok = tight.converged.values.astype(bool)
+    g = float(census.attrs["g"])
+    tol = float(yaml_safe(census.attrs, "basin_tol", 1e-3)) * g
+    A = np.stack([census.accel_x.values, census.accel_y.values], -1)
+    runs = np.stack([tight.accel_x.values, tight.accel_y.values], -1)[ok]
+    d = np.abs(runs[:, None] - A[None]).reshape(len(runs), len(A), -1).max(-1)
+    label = np.where(d.min(1) <= tol, d.argmin(1), -1)
+    X = runs[:, grain]
+    Y = np.where(label[:, None] >= 0, A[np.maximum(label, 0), grain], np.nan)
+    E = X - Y
+    lab = label >= 0
+    cx = cloud_stats(X[:, 0], X[:, 1]) if len(X) else None
+    cy = cloud_stats(Y[lab, 0], Y[lab, 1]) if lab.any() else None
+    visited, counts = np.unique(label[lab], return_counts=True)
+    return {"n_runs": int(tight.sizes["run"]), "n_converged": int(ok.sum()), "n_labelled": int(lab.sum()),
+            "visited": visited, "counts": counts,
+            "major": float(cx["major"]) if cx else np.nan, "minor": float(cx["minor"]) if cx else np.nan,
+            "ratio": float(cx["ratio"]) if cx else np.nan, "spread": float(cx["spread"]) if cx else np.nan,
+            "census_major": float(cy["major"]) if cy else np.nan, "census_minor": float(cy["minor"]) if cy else np.nan,
+            "rms_offset": float(np.sqrt(np.mean(np.sum(E[lab] ** 2, 1)))) if lab.any() else np.nan,
+            "max_offset": float(np.hypot(*E[lab].T).max()) if lab.any() else np.nan, "g": g,
+            "n_solutions": len(A)}
+
+
+def cloud_text(c, grain, tol, line_ratio):
+    """Markdown: what the chosen grain's cloud is, from :func:`cloud_against_census`."""
+    g = c["g"]
+    head = (f"At {tol:.0e}, {c['n_converged']} of the {c['n_runs']} zero-guess runs converged; the cloud of "
+            f"grain {grain} has RMS extents {c['major']:.2g} and {c['minor']:.2g} m/s² (minor/major "
+            f"{c['ratio']:.2g}). The census places {c['n_labelled']} of these runs on "
+            f"{len(c['visited'])} exact solution(s) ("
+            + ", ".join(f"solution {k}: {n} runs" for k, n in zip(c["visited"], c["counts"]))
+            + f"); the runs lie within {c['rms_offset']:.1e} m/s² RMS ({c['rms_offset'] / g:.1e} $g$, at most "
+            f"{c['max_offset'] / g:.1e} $g$) of their solutions: that is the iteration error left at this "
+            "tolerance, and it bounds how far the cloud's axes can differ from those of the solutions' points ")
+    if len(c["visited"]) <= 1:
+        return head + (f"(here one point). The cloud is **iteration error around one of the census's "
+                       f"{c['n_solutions']} exact solution(s)**, not a line of solutions: its shape (minor/major "
+                       f"{c['ratio']:.2g}) is that of the unfinished iteration.")
+    shape = ("a segment" if len(c["visited"]) == 2 else
+             ("a line" if c["census_minor"] < line_ratio * c["census_major"] else "not a line"))
+    return head + (f"(RMS extents {c['census_major']:.2g} and {c['census_minor']:.2g} m/s²). The cloud is "
+                   f"**{len(c['visited'])} of the census's {c['n_solutions']} exact solutions, {shape}**, blurred "
+                   "by the iteration error.")
 
 
 def census_text(ds):
@@ -331,13 +383,18 @@ def census_text(ds):
             f"{float(ds.law_violation.max()):.0e}): {a['n_nlgs']} among the NLGS end points (zero-guess, "
             f"warm-start and {a['random_converged']} converged random-guess runs), {a['n_lemke']} by Lemke's "
             f"method ({a['lemke_status']}), {a['n_enumeration']} by the enumeration of "
-            f"{a['n_patterns']} status patterns. ")
+            f"{a['n_patterns']} status patterns (per round: "
+            f"{', '.join(str(int(v)) for v in np.atleast_1d(a['patterns_per_round']))}; the switching contacts, "
+            f"{ds.sizes['switching_contact']} in the end, in "
+            f"{', '.join(str(int(v)) for v in np.atleast_1d(a['clusters_per_round']))} clusters). ")
     seg = ds.segment_residual.values
     pair = np.atleast_1d(a["segment_pair"])
     if n >= 2 and np.all(np.isfinite(seg)):
-        head += (f"The straight segment between the two most visited solutions ({pair[0]} and {pair[1]}) holds "
-                 f"no solution: residual {seg.min():.1e} to {seg.max():.1e} at t = "
-                 f"{', '.join(f'{t:g}' for t in ds.segment_t.values)}.")
+        verdict = ("holds no solution at these points" if seg.min() > 1e-8 else
+                   "comes close to a solution at some of these points")
+        head += (f"The straight segment between the two solutions most visited by the ensemble ({pair[0]} and "
+                 f"{pair[1]}), sampled at t = {', '.join(f'{t:g}' for t in ds.segment_t.values)}, {verdict}: "
+                 f"relative residual {seg.min():.1e} to {seg.max():.1e}.")
     inits = [v for v in ds.data_vars if v.startswith("n_") and v not in ("n_random", "n_switched", "n_grains_differ")]
     cols = ["solution", "found by"] + [f"{v[2:]} runs" for v in inits] + [
         "random runs", "returns after 1e-9 noise", "grain accel. (m/s²)", "contacts switched", "grains differ"]

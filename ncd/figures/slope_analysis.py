@@ -15,8 +15,13 @@
   grains may still roll on each other, so the fit measures how far from
   rigid the difference is) and the number of sticking links from every grain
   to the nearest switching contact;
+* :func:`status_patterns` (for the census, :mod:`ncd.figures.census`): status
+  patterns combining the changes seen between several solutions, cluster by
+  cluster of switching contacts (:func:`contact_clusters`);
 * :func:`measures_dataset`: all of it as one Dataset (``measures.nc``).
 """
+import itertools
+
 import numpy as np
 import xarray as xr
 
@@ -221,6 +226,89 @@ def contact_relation(traj, ens, labels, g):
             "cluster_size": size, "n_stick_both": n_stick, "n_contacts": n_act,
             "switch_distance": _switch_distance(nm, a, b, stick_both, src), "switched": switched.astype(np.int8),
             "representative_runs": np.array(runs)}
+
+
+def switching_contacts(statuses):
+    """Contacts whose status differs between any two of the solutions (rows of ``statuses``)."""
+    statuses = np.asarray(statuses)
+    return np.nonzero((statuses != statuses[:1]).any(0))[0] if len(statuses) else np.zeros(0, np.int64)
+
+
+def contact_clusters(contacts, n_mobile, idx):
+    """Groups of the contacts ``idx`` joined through a shared mobile grain (list of index arrays)."""
+    parent = list(range(len(idx)))
+
+    def find(i):
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    owner = {}
+    for k, c in enumerate(idx):
+        for b in (int(contacts.body_a[c]), int(contacts.body_b[c])):
+            if 0 <= b < n_mobile:
+                if b in owner:
+                    parent[find(k)] = find(owner[b])
+                else:
+                    owner[b] = k
+    roots = np.array([find(k) for k in range(len(idx))], np.int64)
+    return [np.asarray(idx)[roots == r] for r in np.unique(roots)]
+
+
+def cluster_options(statuses, cluster, max_local=16):
+    """Status choices of one cluster: every combination of the statuses the solutions
+    take at its contacts (when there are at most ``max_local``), else the solutions' own."""
+    seen = [np.unique(statuses[:, c]) for c in cluster]
+    if np.prod([len(v) for v in seen], dtype=float) <= max_local:
+        return np.array(list(itertools.product(*seen)), np.int8)
+    return np.unique(statuses[:, cluster], axis=0).astype(np.int8)
+
+
+def status_patterns(statuses, contacts, n_mobile, max_patterns, rng):
+    """Status patterns combining the changes seen between the solutions found.
+
+    The contacts whose status differs between any two solutions are grouped into
+    clusters (sharing a grain); each cluster takes one of its options
+    (:func:`cluster_options`).  All combinations when there are at most
+    ``max_patterns``; otherwise every single-cluster change of every solution, then
+    combinations drawn at random (``rng``) up to ``max_patterns``.  Returns
+    ``(patterns, switching, n_clusters)``; patterns equal to a solution's are left out."""
+    statuses = np.asarray(statuses, np.int8)
+    sw = switching_contacts(statuses)
+    if len(sw) == 0:
+        return np.zeros((0, statuses.shape[1]), np.int8), sw, 0
+    clusters = contact_clusters(contacts, n_mobile, sw)
+    opts = [cluster_options(statuses, cl) for cl in clusters]
+    total = np.prod([len(o) for o in opts], dtype=float)
+    out = []
+    if total <= max_patterns:
+        for pick in itertools.product(*[range(len(o)) for o in opts]):
+            p = statuses[0].copy()
+            for cl, o, j in zip(clusters, opts, pick):
+                p[cl] = o[j]
+            out.append(p)
+    else:
+        for base in statuses:
+            for cl, o in zip(clusters, opts):
+                for row in o:
+                    if not np.array_equal(row, base[cl]):
+                        p = base.copy()
+                        p[cl] = row
+                        out.append(p)
+        while len(out) < max_patterns:
+            p = statuses[0].copy()
+            for cl, o in zip(clusters, opts):
+                p[cl] = o[rng.integers(len(o))]
+            out.append(p)
+    known = {row.tobytes() for row in statuses}
+    uniq, seen = [], set()
+    for p in out[:max(max_patterns, 0)]:
+        key = p.tobytes()
+        if key not in known and key not in seen:
+            seen.add(key)
+            uniq.append(p)
+    return np.array(uniq, np.int8).reshape(-1, statuses.shape[1]), sw, len(clusters)
 
 
 def measures_dataset(traj, ens, cfg):
