@@ -242,6 +242,29 @@ def test_the_cloud_is_the_census_solutions_plus_the_iteration_error(data, result
         assert meas.attrs["n_solutions"] >= 2
 
 
+def test_cloud_against_census_on_a_synthetic_segment():
+    """Runs on two of three solutions plus a small error: labels, counts and the axis bound."""
+    from ncd.figures import census as cs
+    rng = np.random.default_rng(7)
+    sol = rng.normal(size=(3, 5, 2))                      # 3 solutions, 5 discs
+    pick = np.array([0] * 7 + [2] * 13)
+    err = 1e-6 * rng.normal(size=(20, 5, 2))
+    runs = sol[pick] + err
+    acc = np.stack([runs + 1.0, runs])                    # tol axis: loose (far off), tight
+    ens = xr.Dataset({"accel_x": (("init", "tol", "run", "disc"), acc[None, ..., 0]),
+                      "accel_y": (("init", "tol", "run", "disc"), acc[None, ..., 1]),
+                      "converged": (("init", "tol", "run"), np.ones((1, 2, 20), bool))},
+                     coords={"init": ["zero"], "tol": [1e-4, 1e-8]})
+    cen = xr.Dataset({"accel_x": (("solution", "disc"), sol[..., 0]), "accel_y": (("solution", "disc"), sol[..., 1])},
+                     attrs={"g": 9.81, "config_yaml": yaml.safe_dump({"basin_tol": 1e-3})})
+    c = cs.cloud_against_census(ens, cen, 3, "zero")
+    assert c["visited"].tolist() == [0, 2] and c["counts"].tolist() == [7, 13] and c["n_solutions"] == 3
+    assert c["census_minor"] <= 1e-12 * c["census_major"]          # two points: a segment
+    assert c["rms_offset"] == pytest.approx(np.sqrt(np.mean(np.sum(err[:, 3] ** 2, -1))), rel=1e-9)
+    assert abs(c["major"] - c["census_major"]) <= c["rms_offset"] and c["minor"] <= c["rms_offset"]
+    assert "2 of the census's 3 exact solutions, a segment" in cs.cloud_text(c, 3, 1e-8, 0.05)
+
+
 def test_status_patterns_combine_the_changes_cluster_by_cluster():
     """Three solutions on six contacts: contacts 1, 2 (grain 5 shared) and 4 switch; two
     clusters, all combinations of the statuses seen (2 x 2 at the pair, 3 at contact 4 = 12,
