@@ -1,45 +1,47 @@
 """Finishing stage: the exact solution NLGS converges towards (issue 13, item 2).
 
-NLGS settles the *status* of every contact long before its impulses converge:
-open (``s = 0``), stick (``U_n = U_t = 0``), slide forward (``U_n = 0``,
-``s_t = -mu s_n``, ``U_t >= 0``) or slide backward (``s_t = +mu s_n``,
-``U_t <= 0``).  On fixed statuses the Signorini-Coulomb law is linear in the
-impulses, so the finishing stage (a primal-dual active-set / semismooth Newton
-method on the natural map):
+NLGS settles the *status* of every contact (open, stick, slide forward or
+backward) long before its impulses converge, and on a dense or indeterminate
+problem (a pile at rest, a wedged grain) its last decades of residual take
+most of the sweeps, or never come.  With the statuses fixed the one-step
+solutions form a polyhedron (2-D Coulomb cones are polyhedral,
+:mod:`ncd.finish_lp`), so the finishing stage (:func:`polish`):
 
-1. writes the impulses of the statuses as ``s = P x`` (two unknowns per sticking
-   contact, ``s_n`` per sliding one, none per open one) and their velocity
-   conditions as ``S^T (W P x + q) = 0``, ``W = H^T M^-1 H``;
-2. moves the NLGS iterate onto that affine set by the *minimum-norm* correction
-   ``x = x_0 + K^+ r`` (``K = S^T W P``; ``W`` is singular wherever the forces
-   are indeterminate, and the minimum-norm correction stays on the solution NLGS
-   was approaching instead of jumping to another one); ``K^+ r`` is iterated
-   Tikhonov on the sparse quasi-definite system ``[[I, K^T], [K, -eps I]]``
-   (one sparse LU, :func:`scipy.sparse.linalg.splu`);
-3. reads the statuses of the candidate from the regions of the natural map
-   ``z = s - rho (U_n + mu |U_t|, U_t)`` (inside the cone: stick; in its polar:
-   open; else slide) at the contacts whose natural map exceeds a fraction of the
-   tolerance (degenerate contacts, zero force or velocity at round-off, keep their
-   status) and repeats until they stop changing; the candidate is
-   accepted only if its relative natural-map residual is ``<= finish_tol``
-   (:data:`SWITCH_ROUNDS` rounds per attempt, more while fewer contacts switch each round);
-4. otherwise returns to NLGS sweeps (chunks growing 4x, within the sweep budget)
-   and tries again from the new iterate (accepted as is if it reaches ``finish_tol``).
+1. lets NLGS go on while its own rate predicts ``finish_tol`` soon
+   (within :data:`LP_SWEEPS` sweeps);
+2. otherwise projects the iterate ``s_k`` on the polyhedron of its statuses: the
+   point ``s`` nearest to ``s_k`` in the L1 norm (an LP, HiGHS), a small
+   correction that stays on the solution NLGS is approaching (no jump to another
+   one of an indeterminate problem);  if that polyhedron is empty, an elastic LP
+   (the statuses' velocity conditions violated at a cost) names the contacts whose
+   status is wrong, switched by the sign of their violation;
+3. accepts the projection when its relative natural-map residual is ``<= finish_tol``
+   and it moves the impulses by at most :data:`MAX_CORRECTION` (relative L1);
+   otherwise NLGS goes on (chunks growing 4x, within the sweep budget) and 2 is tried
+   again.  When the budget runs out the best iterate seen is returned, unconverged.
 
-:func:`check_solution` checks an accepted solution componentwise (cone,
-complementarity, sticking and sliding velocities).
+:func:`check_solution` checks a solution componentwise (cone, complementarity,
+sticking and sliding velocities).  :func:`project_statuses` (the minimum-norm point
+of the affine set of a status pattern, sparse LU) serves the census of
+:mod:`ncd.figures.census`, which enumerates status patterns.
 """
+import logging
+
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from .contacts import h_matrix
+from .finish_lp import StatusLP, project
 from .local_solver import NO_CONTACT, SLIDE_BACKWARD, SLIDE_FORWARD, STICK
 
-SWITCH_ROUNDS = 4        # status switches per attempt before returning to NLGS sweeps
-MAX_SWITCH_ROUNDS = 12   # ... or more while the number of switched contacts keeps falling
-REFINE = 30              # iterated-Tikhonov refinements of one minimum-norm correction
-SWITCH_FRACTION = 1e-2   # a status switches where |F_c| > SWITCH_FRACTION * finish_tol * scale
+LP_SWEEPS = 20000        # NLGS goes on while its rate predicts finish_tol within this many sweeps
+ELASTIC = 1e3            # cost of a unit velocity violation (/ V) against a unit correction (/ S)
+ELASTIC_ROUNDS = 1       # status corrections by the elastic LP per attempt
+MAX_CORRECTION = 0.05    # a projection moving the impulses by more (relative L1) is a jump: rejected
+SLACK = 1e-9             # a contact's violation (/ V) in the elastic LP above which its status changes
+LOG = logging.getLogger(__name__)
+REFINE = 30              # iterated-Tikhonov refinements of one minimum-norm correction (census)
 
 
 def global_delassus(scene, contacts):
@@ -130,52 +132,87 @@ def project_statuses(W, q, mu, s0, status):
     return (P @ (x0 + min_norm_solve(K, r))).reshape(-1, 2)
 
 
-def polish(W, q, mu, rho, scale, s0, status0, tol, more_sweeps=None, max_sweeps=0):
-    """Active-set finishing from the NLGS iterate ``s0`` with statuses ``status0``.
+def switched(status, wrong, U):
+    """New statuses of the ``wrong`` contacts from the sign of the violated velocity at the
+    elastic LP's point: closed with ``U_n > 0``: open; open (``U_n < 0``): stick; stick with
+    ``U_t > 0``: slide forward (``U_t < 0``: backward); sliding the wrong way: stick."""
+    new = status.copy()
+    closed = status != NO_CONTACT
+    opening = wrong & closed & (U[:, 0] > 0)
+    new[opening] = NO_CONTACT
+    new[wrong & ~closed] = STICK
+    tang = wrong & closed & ~opening
+    new[tang & (status == STICK)] = np.where(U[tang & (status == STICK), 1] > 0, SLIDE_FORWARD, SLIDE_BACKWARD)
+    new[tang & (status != STICK)] = STICK
+    return new.astype(np.int8)
 
-    ``more_sweeps(k) -> (s, status)`` continues NLGS by ``k`` sweeps (None: no
-    return to sweeps).  Returns ``(s, status, residual, rounds, ok, extra_sweeps)``."""
-    s_base, status = s0, np.where(status0 > SLIDE_BACKWARD, STICK, status0).astype(np.int8)
-    rounds, extra, chunk = 0, 0, 50
-    best = (np.inf, s0, status)
+
+def polish(lp, W, q, mu, rho, scale, s0, status0, tol, more_sweeps, max_sweeps, sweeps0):
+    """Finishing stage from the NLGS iterate ``s0`` (statuses ``status0``, after ``sweeps0`` sweeps).
+
+    NLGS goes on (``more_sweeps(k) -> (s, status)``) while its rate predicts
+    ``finish_tol`` within :data:`LP_SWEEPS` sweeps; otherwise the
+    iterate is projected on the polyhedron of its statuses (:func:`ncd.finish_lp.project`);
+    if that is empty, an elastic LP (status conditions violated at a cost) names the contacts
+    whose status is wrong, they are switched (:func:`switched`), and the projection is tried again (:data:`ELASTIC_ROUNDS` times); a projection is accepted when
+    its natural-map residual is ``<= tol``.  If none is, NLGS goes on (chunks growing
+    4x) and the projection is tried again.  Returns ``(s, status, residual, lp_solves, ok, extra_sweeps, correction)``, the
+    best iterate when the sweep budget runs out; ``correction`` is the relative L1 size
+    ``|s - s_k|_1 / |s_k|_1`` of the accepted projection (0 when NLGS got there)."""
+    def residual(s):
+        return relative_residual(s, (W @ s.ravel() + q).reshape(-1, 2), mu, rho, scale)
+
+    s, status = s0, np.where(status0 > SLIDE_BACKWARD, STICK, status0).astype(np.int8)
+    res = residual(s)
+    best = (res, s, status)
+    solves, extra, chunk, rate = 0, 0, max(50, sweeps0 // 4), None
     while True:
-        U = (W @ s_base.ravel() + q).reshape(-1, 2)
-        res = relative_residual(s_base, U, mu, rho, scale)
-        if res < best[0]:
-            best = (res, s_base, status)
-        if res <= tol:                   # NLGS got there by itself
-            return s_base, status, res, rounds, True, extra
-        seen, switches, k_round = set(), np.inf, 0
-        while k_round < SWITCH_ROUNDS or (k_round < MAX_SWITCH_ROUNDS and shrinking):
-            rounds += 1
-            k_round += 1
-            cand = project_statuses(W, q, mu, s_base, status)
-            U = (W @ cand.ravel() + q).reshape(-1, 2)
-            F, region = natural_map(cand, U, mu, rho)
-            res = float(np.sqrt(np.sum(F ** 2)) / max(scale, np.sqrt(np.sum(cand ** 2)), 1e-300))
-            if res < best[0]:
-                best = (res, cand, region)
-            if res <= tol:
-                return cand, region, res, rounds, True, extra
-            # switch only where the law is violated by more than a fraction of the tolerance:
-            # degenerate contacts (force on a region boundary, velocity at round-off) keep
-            # their status, which satisfies both conditions (else the statuses cycle)
-            wrong = np.sqrt(np.sum(F ** 2, axis=1)) > SWITCH_FRACTION * tol * max(scale, np.linalg.norm(cand))
-            new = np.where(wrong, region, status).astype(np.int8)
-            key = new.tobytes()
-            if np.array_equal(new, status) or key in seen:
-                break
-            seen.add(key)
-            shrinking = np.count_nonzero(new != status) < switches   # statuses settling: go on
-            switches = np.count_nonzero(new != status)
-            status = new
-        if more_sweeps is None or extra >= max_sweeps:
-            return best[1], best[2], best[0], rounds, False, extra
-        k = min(chunk, max_sweeps - extra)
-        s_base, status = more_sweeps(k)
+        if res <= tol:
+            return s, status, res, solves, True, extra, 0.0
+        ahead = None if rate is None or rate <= 0 else np.log(res / tol) / rate
+        if ahead is not None and ahead <= LP_SWEEPS:
+            k = int(min(np.ceil(1.2 * ahead) + 10, max_sweeps - extra))     # NLGS converges: let it
+        else:
+            st_try = status
+            for trial in range(1 + 2 * ELASTIC_ROUNDS):
+                # even trials: the projection; odd ones: the elastic LP, whose violated
+                # contacts are switched by the sign of their violation
+                solves += 1
+                cand, _, info = project(lp, s, st_try, elastic=ELASTIC if trial % 2 else 0.0)
+                r = np.inf if cand is None else residual(cand)
+                LOG.debug("sweeps %d residual %.2e: LP %d (%s, %d iterations) -> %.2e",
+                          sweeps0 + extra, res, trial, info["status"], info["iterations"], r)
+                if cand is None:
+                    if trial % 2:
+                        break
+                    continue
+                region = natural_map(cand, (W @ cand.ravel() + q).reshape(-1, 2), mu, rho)[1]
+                if r < best[0] and info["correction"] <= MAX_CORRECTION * np.abs(s).sum():
+                    best = (r, cand, region)
+                corr = info["correction"] / max(np.abs(s).sum(), 1e-300)
+                if r <= tol and corr <= MAX_CORRECTION:
+                    return cand, region, r, solves, True, extra, corr
+                if corr > MAX_CORRECTION:
+                    break        # another solution, far from the iterate: more sweeps first
+                if trial % 2:
+                    wrong = info["slack"] > SLACK
+                    if not wrong.any():
+                        break
+                    st_try = switched(st_try, wrong, (W @ cand.ravel() + q).reshape(-1, 2))
+                elif trial:
+                    break        # the switched statuses' polyhedron holds no solution either
+            k = min(chunk, max_sweeps - extra)
+            chunk *= 4
+        if k <= 0:
+            return best[1], best[2], best[0], solves, False, extra, float("nan")
+        s_new, status = more_sweeps(k)
         status = np.where(status > SLIDE_BACKWARD, STICK, status).astype(np.int8)
         extra += k
-        chunk *= 4
+        res_new = residual(s_new)
+        rate = np.log(res / res_new) / k if res_new > 0 else np.inf
+        s, res = s_new, res_new
+        if res < best[0]:
+            best = (res, s, status)
 
 
 def check_solution(impulse, U, mu, tol=1e-8, velocity_scale=None):
@@ -218,12 +255,16 @@ def polish_local(Wc, q, mu, Wd, data, order, result, settings):
         _iterate_local(data, order, status, scale, 0.0, k, 0, k, keep)
         return flat.reshape(n, 2).copy(), status.copy()
 
-    s, st, res, rounds, ok, extra = polish(Wc, q, mu, 1.0 / Wd[:, 0, 0], scale, flat.reshape(n, 2).copy(),
-                                           status.copy(), settings.finish_tol, more, settings.max_sweeps)
-    return _finished(result, s, st, res, rounds, ok, extra)
+    s0 = flat.reshape(n, 2).copy()
+    lp = StatusLP.local(Wc, q, mu, max(float(np.abs(s0).max(initial=0.0)), scale / np.sqrt(n)),
+                        max(float(np.abs(q).max()), 1e-300))
+    out = polish(lp, Wc, q, mu, 1.0 / Wd[:, 0, 0], scale, s0, status.copy(), settings.finish_tol, more,
+                 settings.max_sweeps, result.sweeps)
+    flat[:] = out[0].ravel()
+    return _finished(result, *out)
 
 
-def polish_discs(scene, contacts, q_free, Wb, flat, order, result, settings):
+def polish_discs(scene, contacts, vel, spin, bias, q_free, Wb, flat, order, result, settings):
     """The finishing stage of :func:`ncd.nlgs.solve_discs`; updates the body velocities."""
     from .nlgs import _iterate_discs, _scale
     n = contacts.n
@@ -238,24 +279,27 @@ def polish_discs(scene, contacts, q_free, Wb, flat, order, result, settings):
         return imp.reshape(n, 2).copy(), status.copy()
 
     # q of U = W s + q: the free local velocity (bias included) of :func:`solve_discs`
-    s, st, res, rounds, ok, extra = polish(W, q_free.ravel(), contacts.mu, 1.0 / Wb[:, 0, 0], scale,
-                                           s_start, status.copy(), settings.finish_tol, more,
-                                           settings.max_sweeps)
-    du = minv * (H @ (s - imp.reshape(n, 2)).ravel())
     nm = scene.n_mobile
-    body[:nm, 0] += du[0::3]
-    body[:nm, 1] += du[1::3]
-    body[:nm, 2] += du[2::3]
-    imp[:] = s.ravel()
-    return _finished(result, s, st, res, rounds, ok, extra)
+    free = np.column_stack([vel[:nm], spin[:nm]]).ravel()       # u_free (vel, spin untouched so far)
+    lp = StatusLP.discs(H, minv, free, bias, contacts.mu, scene.radius[:nm],
+                        max(float(np.abs(s_start).max(initial=0.0)), scale / np.sqrt(n)),
+                        max(float(np.abs(q_free).max()), 1e-300))
+    out = polish(lp, W, q_free.ravel(), contacts.mu, 1.0 / Wb[:, 0, 0], scale, s_start, status.copy(),
+                 settings.finish_tol, more, settings.max_sweeps, result.sweeps)
+    s = out[0]
+    if not np.array_equal(s, imp.reshape(n, 2)):       # a projection: u_f = u_free + M^-1 H s
+        body[:nm, :3] = (free + minv * (H @ s.ravel())).reshape(nm, 3)
+        imp[:] = s.ravel()
+    return _finished(result, *out)
 
 
-def _finished(result, s, status, res, rounds, ok, extra):
+def _finished(result, s, status, res, solves, ok, extra, correction):
     result.impulse = s
     result.status = status
     result.residual = res
     result.converged = bool(ok)
-    result.finish_rounds = rounds
+    result.finish_rounds = solves
+    result.finish_correction = correction
     result.sweeps += extra
     result.observable_change = float("nan")   # an exact solution: nothing left to settle
     return result
