@@ -8,11 +8,13 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 import xarray as xr
+import yaml
 
 import ncd
 from ncd.contacts import h_matrix
 from ncd.figures import governing as fg
 from ncd.figures import governing_exact as ge
+from ncd.figures import governing_line as gl
 from ncd.figures.equilibrium import external_force, rest_problem
 
 
@@ -125,3 +127,151 @@ def test_eta_small_friction_below_peak(packings):
     for k in set(packings.kind.values.tolist()):
         t = fg.eta_table(packings, "eta_exact", k)
         assert t[0, 1] < 0.8 * np.nanmax(t[:, 1])
+
+
+# ---------------------------------------------------------------- why a line (item 3)
+
+
+def _chain_case():
+    """Six grains in a chain 0-1-2-3-4-5 (contacts k: k-(k+1)) and a ground contact on 0.
+    Solution 1 differs from solution 0 on grains 1, 2 only, along (1, 0.5) (one free
+    cluster, one degree of freedom); solution 2 differs on grains 4, 5 along (0, 1)."""
+    body_a = np.array([0, 1, 2, 3, 4, 0])
+    body_b = np.array([1, 2, 3, 4, 5, -1])
+    a0 = np.zeros((6, 2))
+    a1 = a0.copy()
+    a1[[1, 2]] = [[1.0, 0.5], [2.0, 1.0]]
+    a2 = a0.copy()
+    a2[[4, 5]] = [[0.0, 1.0], [0.0, 3.0]]
+    s0 = np.array([1, 1, 1, 1, 1, 1])
+    s1 = s0.copy()
+    s1[1] = 2                    # the contact 1-2 slides in solution 1
+    s2 = s0.copy()
+    s2[4] = 0                    # the contact 4-5 opens in solution 2
+    return body_a, body_b, (a0, a1, a2), (s0, s1, s2)
+
+
+def test_cluster_test_on_one_known_free_cluster():
+    """Two solutions differing on one cluster (grains 1, 2, one direction): the contacts
+    switched, the differing grains, their cluster and its one degree of freedom are found
+    exactly, and the line is predicted and observed."""
+    body_a, body_b, a, s = _chain_case()
+    rng = np.random.default_rng(0)
+    pick = rng.integers(0, 2, 40)
+    cloud = np.array([a[k][2] for k in pick]) + rng.normal(0, 1e-6, (40, 2))   # grain 2's cloud
+    out = gl.line_analysis(np.array(a[:2]), np.array(s[:2]), body_a, body_b, cloud, 2, 1e-3)
+    assert out["n_switched"] == 1 and out["n_moving"] == 2 and out["n_clusters"] == 1
+    assert (out["field_rank"], out["cluster_size"], out["cluster_rank"], out["cloud_rank"]) == (1, 2, 1, 1)
+    assert out["predicted_line"] == 1 and out["hypothesis_holds"] == 1
+    moving, labels = gl.moving_clusters(np.array([a[1] - a[0]]), body_a, body_b, np.ones(6, bool), 1e-3)
+    np.testing.assert_array_equal(np.nonzero(moving)[0], [1, 2])
+    np.testing.assert_array_equal(labels, [-1, 0, 0, -1, -1, -1])
+
+
+def test_cluster_test_on_two_independent_clusters():
+    """A third solution moves another cluster (grains 4, 5) in another direction: two
+    clusters, the whole field spans two directions, yet grain 2's cluster keeps one
+    degree of freedom and its cloud a line; a grain moved by both would not."""
+    body_a, body_b, a, s = _chain_case()
+    pick = np.arange(30) % 3
+    cloud2 = np.array([a[k][2] for k in pick])
+    out = gl.line_analysis(np.array(a), np.array(s), body_a, body_b, cloud2, 2, 1e-3)
+    assert (out["n_switched"], out["n_moving"], out["n_clusters"], out["field_rank"]) == (2, 4, 2, 2)
+    assert (out["cluster_rank"], out["cloud_rank"], out["predicted_line"], out["hypothesis_holds"]) == (1, 1, 1, 1)
+    # one cluster with two degrees of freedom: grain 2 moves along (1, 0.5) or (0, 1)
+    a3 = np.array(a)
+    a3[2, 2] = [0.0, 1.0]
+    a3[2, [4, 5]] = 0.0
+    cloud3 = np.array([a3[k][2] for k in pick])
+    out = gl.line_analysis(a3, np.array(s), body_a, body_b, cloud3, 2, 1e-3)
+    assert (out["n_clusters"], out["cluster_rank"], out["cloud_rank"], out["predicted_line"]) == (1, 2, 2, 0)
+    assert out["hypothesis_holds"] == 1
+
+
+def test_status_dimension_of_a_disc_in_a_corner():
+    """A disc resting in a corner (floor and wall), both contacts sticking: 4 impulse
+    unknowns, 3 equations of motion, the Delassus matrix has rank 3 -> the impulses keeping
+    the statuses form a line (a self-stress pushing the disc into the corner) along which
+    no grain moves; with the wall open the floor's impulse is fixed."""
+    from ncd.finish import global_delassus
+    from ncd.stepper import prepare_step
+
+    scene = ncd.make_scene([[1.0, 1.0]], [1.0], walls=[((0.0, 0.0), (0.0, 1.0)), ((0.0, 0.0), (1.0, 0.0))],
+                           gravity=(-1.0, -9.81), mu=0.5)
+    problem = prepare_step(scene, 1e-3)
+    assert problem.contacts.n == 2
+    W, H, _ = global_delassus(scene, problem.contacts)
+    assert gl.status_dimension(W, H, problem.contacts.mu, np.array([1, 1])) == (1, 0)
+    assert gl.status_dimension(W, H, problem.contacts.mu, np.array([1, 0])) == (0, 0)
+    assert gl.status_dimension(W, H, problem.contacts.mu, np.array([2, 0])) == (0, 0)
+
+
+def test_cloud_and_field_rank():
+    t = np.linspace(0, 1, 9)
+    assert gl.cloud_rank(t, 2 * t, 1e-3)[0] == 1
+    assert gl.cloud_rank(np.zeros(5), np.zeros(5), 1e-3)[0] == 0
+    assert gl.cloud_rank(np.cos(7 * t), np.sin(7 * t), 1e-3)[0] == 2
+    f = np.zeros((3, 4, 2))
+    f[1, 0] = [1, 0]
+    f[2, 0] = [2, 0]
+    assert gl.field_rank(f, 1e-6) == 1
+    f[2, 3] = [0, 1]
+    assert gl.field_rank(f, 1e-6) == 2
+
+
+# ---------------------------------------------------------------- flows (DAG run)
+def yaml_config(ds):
+    """The config a dataset was computed with (its provenance)."""
+    return yaml.safe_load(ds.attrs["config_yaml"])
+
+
+@pytest.fixture(scope="module")
+def flows(results):
+    return xr.load_dataset(results / "fig5_governing" / "flows.nc")
+
+
+def test_flow_study_design(flows):
+    """Every setting of the one-factor-at-a-time design has its seeds, and every scan
+    is accounted for (indeterminate, determinate or unknown)."""
+    from ncd.figures import governing_flow as gf
+    cfg = yaml_config(flows)["flows"]
+    tab = gf.settings_table(cfg)
+    assert flows.sizes["flow"] == len(tab["mu"]) * cfg["seeds"]
+    np.testing.assert_allclose(np.sort(flows.mu.values), np.sort(np.repeat(tab["mu"], cfg["seeds"])))
+    assert set(np.unique(flows.indeterminate.values)) <= {-1, 0, 1}
+    runs = cfg["scan"]["runs"]
+    assert (flows.converged_zero.values <= runs).all() and (flows.converged_warm.values <= runs).all()
+    none = flows.converged_zero.values + flows.converged_warm.values == 0
+    assert (flows.indeterminate.values[none] == -1).all()
+    assert (flows.n_solutions.values[~none] >= 1).all()
+
+
+def test_indeterminate_steps_have_distinct_exact_solutions(flows):
+    """At an indeterminate step at least two exact solutions differ by more than the
+    threshold; the ranks are consistent (a cluster spans no more directions than the
+    field, the field no more than the solutions allow), and a cluster with one degree of
+    freedom makes the grain's cloud a line (or a point) whatever the iteration error."""
+    cfg = yaml_config(flows)["flows"]
+    ind = flows.indeterminate.values == 1
+    if not ind.any():
+        pytest.skip("no indeterminate step in this run")
+    assert (flows.n_exact.values[ind] >= 2).all()
+    assert (flows.exact_spread.values[ind] > cfg["scan"]["threshold"]).all()
+    nex, fr, cr = flows.n_exact.values[ind], flows.field_rank.values[ind], flows.cluster_rank.values[ind]
+    assert (fr <= nex - 1).all() and (cr <= fr).all() and (fr >= 1).all()
+    assert (flows.cloud_rank.values[ind][cr == 1] <= 1).all()
+    assert (flows.null_velocity.values[ind] <= flows.null_impulse.values[ind]).all()
+    assert np.isnan(flows.field_rank.values[~ind]).all()
+
+
+def test_flow_tables(flows):
+    from ncd.figures import governing_summary as gs
+    m = gs.flow_measures(flows)
+    ok = np.isfinite(m["indeterminate"])
+    assert ((m["indeterminate"][ok] >= 0) & (m["indeterminate"][ok] <= 1)).all()
+    for factor in ("mu", "h", "slope"):
+        t = gs.factor_table(flows, factor, "indeterminate")
+        assert len(t) >= 2 and t[:, 3].sum() >= 2 * yaml_config(flows)["flows"]["seeds"]
+    c = gs.line_counts(flows)
+    assert c["steps"] == int((flows.indeterminate.values == 1).sum()) == sum(c["rank"])
+    assert c["holds"] <= c["steps"] and c["line_and_predicted"] + c["line_not_predicted"] == c["rank"][1]

@@ -1,8 +1,10 @@
-"""Panels of figure 5 (issue 15): eta(mu) exact and Unger et al.'s way, dimensions, coordination."""
+"""Panels of figure 5 (issue 15): eta(mu) exact and Unger et al.'s way, dimensions,
+coordination (packings); indeterminate flow steps against mu, h and slope, and why a line (flows)."""
 import matplotlib.pyplot as plt
 import numpy as np
 
 from .governing import KINDS, eta_table
+from .governing_summary import factor_table, line_counts
 
 UNGER_PEAK_MU = 0.1     # Unger, Kertész & Wolf (2005): eta peaks near mu = 0.1, eta ∝ mu below
 
@@ -45,7 +47,7 @@ def panel_coordination(ax, ds):
         _band(ax, eta_table(ds, "coordination", k), KINDS[k], f"C{2 * k}")
     ax.axhline(3.0, color="k", ls=":", lw=1, label="z = 3 (bulk isostatic, μ → ∞)")
     ax.axhline(4.0, color="k", ls="--", lw=1, label="z = 4 (bulk isostatic, μ = 0)")
-    ax.set(xscale="log", xlabel="μ", ylabel="2κ / N", title="(c) coordination")
+    ax.set(xscale="log", xlabel="μ", ylabel="2κ / N", title="(b) coordination")
     ax.legend(fontsize=7)
 
 
@@ -55,14 +57,62 @@ def panel_unger_vs_exact(ax, ds):
     lim = [np.nanmin(ds.eta_unger.values) * 0.8, np.nanmax(ds.eta_exact.values) * 1.2]
     ax.plot(lim, lim, "k:", lw=1)
     ax.set(xscale="log", yscale="log", xlabel="η exact", ylabel="η Unger et al.'s way",
-           title="(d) sampled against exact")
+           title="(a) sampled against exact")
     plt.colorbar(sc, ax=ax, label="log10 μ")
 
 
-def figure(ds):
-    fig, axes = plt.subplots(2, 2, figsize=(10, 8), constrained_layout=True)
+FACTOR_LABEL = {"mu": ("μ", "linear"), "h": ("h (s)", "log"), "slope": ("slope (°)", "linear")}
+
+
+def panel_flows(ax, flows, factor):
+    """(c) fraction of indeterminate scanned steps (left) and the mean largest spread of a
+    grain's acceleration (right, / |g|) against one factor, 95 % bands over the seeds."""
+    label, scale = FACTOR_LABEL[factor]
+    t = factor_table(flows, factor, "indeterminate")
+    ax.errorbar(t[:, 0], t[:, 1], yerr=np.nan_to_num(t[:, 2]), marker="o", color="C0", capsize=3,
+                label="indeterminate steps")
+    u = factor_table(flows, factor, "unknown")
+    ax.plot(u[:, 0], u[:, 1], "x:", color="0.5", label="unknown (unconverged)")
+    ax.set(xscale=scale, xlabel=label, ylabel="fraction of scanned steps", ylim=(-0.02, 1.02),
+           title=f"(c) flows against {label.split()[0]}")
+    base = {"mu": flows.mu, "h": flows.h, "slope": flows.slope_deg}[factor].values[flows.factor.values == 0]
+    if len(base):
+        ax.axvline(base[0], color="k", lw=0.8, ls=":", label="Figure 2's setting")
+    tw = ax.twinx()
+    sp = factor_table(flows, factor, "spread")
+    ok = np.isfinite(sp[:, 1]) & (sp[:, 1] > 0)
+    if ok.any():
+        tw.errorbar(sp[ok, 0], sp[ok, 1], yerr=np.nan_to_num(sp[ok, 2]), marker="s", color="C3", capsize=3)
+        tw.set_yscale("log")
+    tw.set_ylabel("mean largest spread / |g|", color="C3")
+    ax.legend(fontsize=7, loc="upper left")
+
+
+def panel_line(ax, flows):
+    """(d) ranks of the grain's acceleration cloud at the indeterminate steps, split by the
+    cluster test (the grain's cluster has one degree of freedom, or more)."""
+    ind = flows.indeterminate.values == 1
+    rank, pred = flows.cloud_rank.values[ind], flows.predicted_line.values[ind] == 1
+    x = np.arange(3)
+    one = [int(((rank == r) & pred).sum()) for r in x]
+    more = [int(((rank == r) & ~pred).sum()) for r in x]
+    ax.bar(x - 0.2, one, 0.4, label="cluster with 1 degree of freedom")
+    ax.bar(x + 0.2, more, 0.4, label="cluster with more")
+    c = line_counts(flows)
+    ax.set(xticks=x, xticklabels=["point", "line", "area"], ylabel="indeterminate steps",
+           title=f"(d) why a line: hypothesis holds at {c['holds']} of {c['steps']}")
+    ax.legend(fontsize=7)
+
+
+def figure(ds, flows=None):
+    rows = 1 if flows is None else 2
+    fig, axes = plt.subplots(rows, 4, figsize=(18, 4.2 * rows), constrained_layout=True, squeeze=False)
     panel_eta(axes[0, 0], ds)
     panel_dimension(axes[0, 1], ds)
-    panel_coordination(axes[1, 0], ds)
-    panel_unger_vs_exact(axes[1, 1], ds)
+    panel_coordination(axes[0, 2], ds)
+    panel_unger_vs_exact(axes[0, 3], ds)
+    if flows is not None:
+        for ax, factor in zip(axes[1, :3], ("mu", "h", "slope")):
+            panel_flows(ax, flows, factor)
+        panel_line(axes[1, 3], flows)
     return fig

@@ -4,6 +4,7 @@
 #   exact     exact measures of A ∩ C (HiGHS LPs)              -> shards/exact_<k>-of-<n>.nc
 #   unger     noise + NLGS relaxations (exploration)           -> shards/unger_<k>-of-<n>.nc
 #   merge     every shard of the three                         -> packings.nc
+#   deposit, flow, flows (below): the flows of items 2-3       -> flows.nc
 #   notebook  notebooks/fig5_governing.ipynb                    -> results/figures/fig5_governing.png|pdf
 FIG = "fig5_governing"
 CFG = section(FIG)
@@ -91,6 +92,7 @@ rule fig5_governing_merge:
 rule fig5_governing_notebook:
     input:
         packings=f"{F5}/packings.nc",
+        flows=f"{F5}/flows.nc",
         notebook=notebook_file(FIG),
         notebook_py=notebook_file(FIG, "py"),
     output:
@@ -111,3 +113,78 @@ rule fig5_governing_notebook:
 rule fig5_governing:
     input:
         figure_targets(FIG),
+
+
+# Flows (items 2-3 of issue 15): Figure 2's flow across mu, h and slope, one factor at a
+# time around Figure 2's setting; scans of distinct solutions and why a line.
+#   deposit   one deposit per (mu, seed), shared by the settings of that mu -> shards/deposit_mu<m>_seed<s>.nc
+#   flow      one flow per (setting, seed), scanned                       -> shards/flow_<i>_seed<s>.nc
+#   flows     every flow                                                  -> flows.nc
+from ncd.figures import governing_flow as _gflow
+
+FLOWS = CFG["flows"]
+FLOW_CFG = {"scene": section("fig2_slope")["scene"], "deposit": section("fig2_slope")["deposit"],
+            "flows": without_shards(FLOWS)}
+DEPOSIT_CFG = {"scene": FLOW_CFG["scene"], "deposit": FLOW_CFG["deposit"],
+               "flows": {"base": {"mu": FLOWS["base"]["mu"]}, "mu": FLOWS["mu"], "root_seed": FLOWS["root_seed"]}}
+FLOW_MU = _gflow.settings_table(FLOWS)["mu"]
+DEPOSIT_MU = list(_gflow.deposit_mus(FLOWS))
+FLOW_SHARDS = [f"{F5}/shards/flow_{i}_seed{s}.nc" for i in range(len(FLOW_MU)) for s in range(FLOWS["seeds"])]
+
+
+rule fig5_governing_deposit:
+    input:
+        ncd_sources(FIG),
+    output:
+        temp(f"{F5}/shards/deposit_mu{{m}}_seed{{s}}.nc"),
+    wildcard_constraints:
+        m=r"\d+",
+        s=r"\d+",
+    params:
+        config=DEPOSIT_CFG,
+    log:
+        log(FIG, "deposit_mu{m}_seed{s}"),
+    benchmark:
+        bench(FIG, "deposit_mu{m}_seed{s}")
+    conda:
+        CONDA_ENV
+    script:
+        "../scripts/fig5_governing_deposit.py"
+
+
+rule fig5_governing_flow:
+    input:
+        ncd_sources(FIG),
+        deposit=lambda w: f"{F5}/shards/deposit_mu{DEPOSIT_MU.index(FLOW_MU[int(w.i)])}_seed{w.s}.nc",
+    output:
+        temp(f"{F5}/shards/flow_{{i}}_seed{{s}}.nc"),
+    wildcard_constraints:
+        i=r"\d+",
+        s=r"\d+",
+    params:
+        config=FLOW_CFG,
+    log:
+        log(FIG, "flow_{i}_seed{s}"),
+    benchmark:
+        bench(FIG, "flow_{i}_seed{s}")
+    conda:
+        CONDA_ENV
+    script:
+        "../scripts/fig5_governing_flow.py"
+
+
+rule fig5_governing_flows:
+    input:
+        FLOW_SHARDS,
+    output:
+        f"{F5}/flows.nc",
+    params:
+        dim="flow",
+    log:
+        log(FIG, "flows"),
+    benchmark:
+        bench(FIG, "flows")
+    conda:
+        CONDA_ENV
+    script:
+        "../scripts/merge_shards.py"
