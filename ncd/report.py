@@ -251,6 +251,25 @@ def fig4_history_arching(results):
                     REPRODUCED if abs(med) <= 10 else DIFFERS, "median deviation within 10° of the free surface")
 
 
+# --- figure 5 (beyond the paper: issue 15) -------------------------------------------------------
+
+def fig5_governing_flows(results):
+    from .figures.governing_summary import factor_table
+    flows = _open(results, "fig5_governing/flows.nc")
+    t = factor_table(flows, "mu", "indeterminate")
+    cells = ", ".join(f"μ = {v:g}: {_pct(m)}" for v, m, _, _ in t)
+    return Measured(f"fraction of indeterminate scanned flow steps (mean over seeds) {cells}", BEYOND,
+                    "two exact solutions or more at a scanned step (converged NLGS end points polished)")
+
+
+def fig5_governing_line(results):
+    from .figures.governing_summary import line_counts
+    c = line_counts(_open(results, "fig5_governing/flows.nc"))
+    return Measured(f"{c['steps']} indeterminate steps: grain cloud a line at {c['rank'][1]}, an area at "
+                    f"{c['rank'][2]}; one-degree-of-freedom cluster hypothesis holds at {c['holds']}", BEYOND,
+                    "cloud rank against the rank of the solutions over the grain's cluster")
+
+
 CLAIMS = [
     Claim("fig1_wedged", "§1, Fig. 1", "a possible evolution consists in B losing contact and falling freely. "
           "But, if the friction angle γ is large enough, B may also remain wedged.", fig1_two_evolutions),
@@ -282,6 +301,9 @@ CLAIMS = [
           fig4_history_dip),
     Claim("fig4_history", "§5", "The vector obtained, approximately parallel to the free surface, confirms the "
           "arching trend of force transmission throughout the lateral bank.", fig4_history_arching),
+    Claim("fig5_governing", "§3", "Further study is thus needed to discover the governing parameters",
+          fig5_governing_flows),
+    Claim("fig5_governing", "§3", "and to explain why the dispersion produces a line", fig5_governing_line),
 ]
 
 
