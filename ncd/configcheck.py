@@ -32,6 +32,7 @@ RELATIONS = [
     ("fig2_slope", ("flow", "step"), ("flow", "n_steps"), "<=", "the investigated step is one of the flow steps"),
     ("fig4_pile", ("tolerance_study", "runs"), ("ensemble", "runs"), "<=",
      "the tolerance study reruns members of the ensemble"),
+    ("fig5_governing", ("flows", "scan_every"), ("flows", "duration"), "<=", "a flow is scanned at least once"),
 ]
 # pairs named <x>_min/<x>_max whose bounds may coincide (a degenerate but valid range)
 EQUAL_ALLOWED = ("radius",)
