@@ -35,7 +35,8 @@ from .contacts import h_matrix
 from .finish_lp import StatusLP, project
 from .local_solver import NO_CONTACT, SLIDE_BACKWARD, SLIDE_FORWARD, STICK
 
-LP_SWEEPS = 20000        # NLGS goes on while its rate predicts finish_tol within this many sweeps
+FIRST_CHUNK = 50         # NLGS sweeps (at least; a quarter of those made) that measure NLGS's rate
+LP_SWEEPS = 50000        # NLGS goes on while its rate predicts finish_tol within this many sweeps
 ELASTIC = 1e3            # cost of a unit velocity violation (/ V) against a unit correction (/ S)
 ELASTIC_ROUNDS = 1       # status corrections by the elastic LP per attempt
 MAX_CORRECTION = 0.05    # a projection moving the impulses by more (relative L1) is a jump: rejected
@@ -150,7 +151,7 @@ def switched(status, wrong, U):
 def polish(lp, W, q, mu, rho, scale, s0, status0, tol, more_sweeps, max_sweeps, sweeps0):
     """Finishing stage from the NLGS iterate ``s0`` (statuses ``status0``, after ``sweeps0`` sweeps).
 
-    NLGS goes on (``more_sweeps(k) -> (s, status)``) while its rate predicts
+    NLGS goes on (``more_sweeps(k) -> (s, status)``; a first chunk measures its rate) while its rate predicts
     ``finish_tol`` within :data:`LP_SWEEPS` sweeps; otherwise the
     iterate is projected on the polyhedron of its statuses (:func:`ncd.finish_lp.project`);
     if that is empty, an elastic LP (status conditions violated at a cost) names the contacts
@@ -165,12 +166,14 @@ def polish(lp, W, q, mu, rho, scale, s0, status0, tol, more_sweeps, max_sweeps, 
     s, status = s0, np.where(status0 > SLIDE_BACKWARD, STICK, status0).astype(np.int8)
     res = residual(s)
     best = (res, s, status)
-    solves, extra, chunk, rate = 0, 0, max(50, sweeps0 // 4), None
+    solves, extra, chunk, rate = 0, 0, max(FIRST_CHUNK, sweeps0 // 4, 1), None
     while True:
         if res <= tol:
             return s, status, res, solves, True, extra, 0.0
-        ahead = None if rate is None or rate <= 0 else np.log(res / tol) / rate
-        if ahead is not None and ahead <= LP_SWEEPS:
+        ahead = np.inf if rate is None or rate <= 0 else np.log(res / tol) / rate
+        if rate is None and FIRST_CHUNK > 0:
+            k = min(chunk, max_sweeps - extra)                                # NLGS's rate first
+        elif ahead <= LP_SWEEPS:
             k = int(min(np.ceil(1.2 * ahead) + 10, max_sweeps - extra))     # NLGS converges: let it
         else:
             st_try = status

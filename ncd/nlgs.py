@@ -16,8 +16,8 @@ the relative natural-map residual (:func:`ncd.local_solver.natural_map_sq`,
 ``|rho q_free|``) and a converged flag.  The stopping criterion is either the
 residual (default) or the change; non-convergence at ``max_sweeps`` is flagged,
 and the iterate returned is then the one of smallest residual seen (``keep_best``).
-With ``finish="active_set"`` the NLGS iterate is polished to ``finish_tol`` by
-:mod:`ncd.finish`; with an ``observe`` callable the run is made in chunks of
+With ``finish="active_set"`` the NLGS iterate is finished to ``finish_tol`` by
+:mod:`ncd.finish` (projection on the polyhedron of its contact statuses, an LP); with an ``observe`` callable the run is made in chunks of
 ``check_every`` sweeps and stops only when the observable has settled too
 (:mod:`ncd.convergence`).
 """
@@ -41,9 +41,9 @@ FINISHES = ("none", "active_set")
 class SolverSettings:
     """NLGS settings: tolerance on the chosen criterion, sweep budget, finishing stage.
 
-    ``finish``: "none" (plain NLGS) or "active_set" (:func:`ncd.finish.polish`: the
-    statuses NLGS has settled, solved exactly by a minimum-norm correction, checked
-    and switched until the natural-map residual is <= ``finish_tol``).
+    ``finish``: "none" (plain NLGS) or "active_set" (:func:`ncd.finish.polish`: where
+    NLGS's rate is slow, its iterate projected (L1, LP) on the solutions with the contact
+    statuses it has settled, the active set, until the natural-map residual is <= ``finish_tol``).
     ``observable_tol``: largest relative change of an observed quantity over the
     last residual checks for a run to count as converged (:mod:`ncd.convergence`).
     ``keep_best``: at ``max_sweeps`` return the iterate of smallest residual seen.

@@ -1,10 +1,40 @@
-"""Time to tolerance (1e-6, 1e-8, 1e-10): plain NLGS and NLGS + finishing stage."""
+"""Time to tolerance (1e-6, 1e-8, 1e-10): plain NLGS and NLGS + finishing stage side by side,
+on the dense packings (-> tolerance.nc) and on the pile's final state and Figure 2's
+investigated step, from the zero guess, identity and random review orders (-> tolerance_problems.nc)."""
+import numpy as np
+import xarray as xr
+
+from ncd.figures import pile, slope
+from ncd.finish_bench import FIELDS, METHODS, time_to_tolerance
 from ncd.io import provenance, write_dataset
 from ncd.pipeline import start
+from ncd.stepper import prepare_step
 from ncd.studies.bench import environment, tolerance_table
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)
 cfg = snakemake.params.config  # noqa: F821
 ds = tolerance_table(cfg, log)
 ds.attrs.update(provenance(cfg, **environment()))
-write_dataset(ds, snakemake.output[0])  # noqa: F821
+write_dataset(ds, snakemake.output.packings)  # noqa: F821
+
+pcfg, scfg = snakemake.params.pile, snakemake.params.slope  # noqa: F821
+construction = xr.load_dataset(snakemake.input.construction)  # noqa: F821
+scene = pile.final_scene(pcfg, construction)
+problems = {"pile": (scene, pile.equilibrium_problem(pcfg, scene, construction))}
+traj = xr.load_dataset(snakemake.input.trajectory)  # noqa: F821
+scene = slope.scene_at_step(traj, scfg)
+problems["fig2_step"] = (scene, prepare_step(scene, float(traj.attrs["h"])))
+out = {k: [] for k in FIELDS}
+for name, (scene, problem) in problems.items():
+    n = problem.contacts.n
+    orders = [None] + [np.random.default_rng((k, cfg["root_seed"])).permutation(n) for k in range(1, cfg["orders"])]
+    res = time_to_tolerance(scene, problem, cfg["tolerances"], cfg["handoff"], cfg["problem_sweeps"], orders,
+                            log=log, label=name)
+    for k in FIELDS:
+        out[k].append(res[k])
+ds = xr.Dataset({k: (("problem", "order", "solver", "tol"), np.array(v), {"units": FIELDS[k][0], "long_name": FIELDS[k][1]})
+                 for k, v in out.items()},
+                coords={"problem": list(problems), "order": np.arange(cfg["orders"]), "solver": list(METHODS),
+                        "tol": cfg["tolerances"]})
+ds.attrs.update(provenance(cfg, **environment()))
+write_dataset(ds, snakemake.output.problems)  # noqa: F821
