@@ -3,6 +3,7 @@
 #             time per step and memory on dense packings       -> results/bench/core.nc
 #   sweeps    sweeps to a fixed tolerance against N             -> results/bench/sweeps.nc
 #   tolerance time to 1e-6/1e-8/1e-10, NLGS and NLGS + finish -> results/bench/tolerance.nc
+#             (dense packings), tolerance_problems.nc (the pile's final state, fig2's step)
 #   ensemble  NLGS ensemble on 1 and 2 threads                  -> results/bench/ensemble.nc
 #   peer      ncd and pymunk side by side on a poured pile      -> results/bench/peer.nc
 #   rules     wall time of every rule of the figures' run       -> results/bench/rules.nc
@@ -53,11 +54,16 @@ rule bench_sweeps:
 rule bench_tolerance:
     input:
         ncd_sources(FIGB),
+        construction="results/fig4_pile/construction.nc",
+        trajectory="results/fig2_slope/trajectory.nc",
     output:
-        "results/bench/tolerance.nc",
+        packings="results/bench/tolerance.nc",
+        problems="results/bench/tolerance_problems.nc",
     threads: BENCH_THREADS
     params:
         config=CFGB["tolerance"],
+        pile=without_shards(section("fig4_pile")),
+        slope=without_shards(section("fig2_slope")),
     log:
         log(FIGB, "tolerance"),
     benchmark:
