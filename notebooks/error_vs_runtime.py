@@ -32,7 +32,9 @@
 #    states built in `ncd.studies.work_precision` — a settled 28-disc packing in a box,
 #    a small settled pile on a rough floor, and a step of a periodic slope flow at 24°
 #    (a few hundred discs by default) — every setting (initial guess zero or warm,
-#    stopping criterion natural-map residual or impulse change, tolerance) gives one
+#    stopping criterion natural-map residual or impulse change, or NLGS with the finishing
+#    stage of `ncd.finish` (criterion `finish`: NLGS to $10^{-4}$, then, where NLGS's rate
+#    is slow, the projection on the polyhedron of its contact statuses), tolerance) gives one
 #    point: its wall time (best of a few repeats), its sweeps, its relative natural-map
 #    residual $|s - \mathrm{proj}_K(s - \rho\tilde U)|/\max(|s|, |\rho q|)$ and its
 #    distance to the limit of the same iteration (same guess, same review order) run to
@@ -98,7 +100,9 @@ for j, state in enumerate(nl.state.values):
     for xkey, row in (("wall_time", 0), ("sweeps", 1)):
         ax = axes[row, j]
         for init in d.init.values:
-            for crit, style in (("residual", "-"), ("change", ":")):
+            for crit, style in (("residual", "-"), ("change", ":"), ("finish", "-.")):
+                if crit not in d.criterion.values:
+                    continue
                 e = d.sel(init=init, criterion=crit)
                 x = e[xkey].values * (1e3 if xkey == "wall_time" else 1)
                 ax.plot(x, np.maximum(e.error_velocity, FLOOR), style, marker="o", ms=4,

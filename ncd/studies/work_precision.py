@@ -69,8 +69,9 @@ FINISH_HANDOFF = 1e-4     # NLGS tolerance handed to the finishing stage (criter
 def nlgs_work_precision(s, h, tols, inits, criteria, reference, repeats, max_sweeps):
     """All settings on the core problem of the next step of ``s``; a Dataset with
     dimensions ``(init, criterion, tol)``.
-    Criterion ``"finish"``: NLGS to ``max(tol, FINISH_HANDOFF)``, then the active-set
-    finishing stage (:mod:`ncd.finish`) to ``tol``."""
+    Criterion ``"finish"``: NLGS to ``max(tol, FINISH_HANDOFF)``, then the finishing stage
+    (:mod:`ncd.finish`: NLGS while its rate is good, else the projection on its statuses'
+    polyhedron) to ``tol``."""
     problem = prepare_step(s, h)
     guesses = {init: initial_guess(s, problem, init) for init in inits}
     ref_settings = SolverSettings(tol=reference["tol"], max_sweeps=reference["max_sweeps"])
