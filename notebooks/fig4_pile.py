@@ -317,8 +317,8 @@ pm.draw_exact_band(ax, exact, d)
 ax.set_xlabel("x / d")
 ax.set_ylabel("vertical ground force per length (N/m)")
 ax.legend(fontsize=7)
-ax.set_title(f"(d) ground pressure: bins of {cfg['pressure']['bin_d']:g} d ({conv.sum()} rest runs), "
-             "kernel of the ground contacts", fontsize=9)
+ax.set_title(f"(d) ground pressure: {cfg['pressure']['bin_d']:g} d bins ({conv.sum()} rest runs), kernel",
+             fontsize=9)
 
 # (e) tolerance study
 ax = fig.add_subplot(gs[2, 0])
