@@ -80,7 +80,8 @@ class PointSource(_Source):
     """A localized source above the pile axis ``x = 0``: ``slots`` insertion sites in a
     row, ``drop_height_d`` mean diameters above the settled grains under it (so that
     impacts stay gentle while the pile grows); ``source.rows`` (default 1) grains are
-    tried per site, stacked ``2.2 radius_max`` apart (a denser stream, same speed)."""
+    tried per site, stacked ``2.2 radius_max`` apart (same speed; a site refills when its
+    column has fallen, so the steady flux per site stays ``inlet_speed / pitch``)."""
 
     def __init__(self, cfg, rng, y_ground, radii=None):
         s = cfg["source"]
