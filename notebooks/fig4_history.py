@@ -30,8 +30,8 @@
 # grains (same radii, inserted in the same order) on the *same* rough ground:
 #
 # 1. *point source*: Figure 4's construction (insertion sites above $x = 0$, a drop
-#    height that rises with the pile), with a denser stream (grains stacked three
-#    high per site, same speed);
+#    height that rises with the pile), with up to three grains stacked per site at
+#    each attempt (same speed);
 # 2. *rain*: the grains dropped at positions uniform over $|x| \le L$, $L$ the base
 #    half-width of the member's point-source pile, from a height that rises with the
 #    deposit, onto a **finite base**: the member's ground discs with $|x| \le L$, as in
