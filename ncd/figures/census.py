@@ -39,7 +39,7 @@ from ..lcp import frictional_lcp, impulse_of_lcp, lemke
 from ..local_solver import STICK, SLIDE_BACKWARD
 from ..nlgs import SolverSettings
 from ..stepper import prepare_step, solve_problem
-from .slope_analysis import status_patterns, switching_contacts
+from .slope_analysis import cloud_against_census, status_patterns, switching_contacts  # noqa: F401
 
 METHODS = ("nlgs", "lemke", "enumeration")
 
@@ -313,45 +313,9 @@ def census_dataset(traj, ens, measures, cfg, log=None):
     return ds
 
 
-def cloud_against_census(ens, census, grain, init="zero"):
-    """The chosen grain's cloud at the tightest tolerance, read through the census.
-
-    Every converged ``init`` run is labelled with the census solution whose whole
-    acceleration field lies within ``basin_tol |g|`` of its own (-1: none).  With
-    ``X`` the runs' accelerations of ``grain`` and ``Y`` those of their solutions,
-    ``E = X - Y``: the principal axes (RMS extents) of the cloud ``X`` differ from
-    those of ``Y`` by at most ``rms(E)`` (singular values are 1-Lipschitz in the
-    Frobenius norm), so the cloud is a set of solutions with the shape of ``Y``
-    (one point, a segment for two solutions, ...) blurred by the iteration error
-    ``E``.  Returns a dict of counts and axes (m s-2)."""
-    from .slope_analysis import cloud_stats
-    tight = ens.sel(init=init).isel(tol=-1)
-    ok = tight.converged.values.astype(bool)
-    g = float(census.attrs["g"])
-    tol = float(yaml_safe(census.attrs, "basin_tol", 1e-3)) * g
-    A = np.stack([census.accel_x.values, census.accel_y.values], -1)
-    runs = np.stack([tight.accel_x.values, tight.accel_y.values], -1)[ok]
-    d = np.abs(runs[:, None] - A[None]).reshape(len(runs), len(A), -1).max(-1)
-    label = np.where(d.min(1) <= tol, d.argmin(1), -1)
-    X = runs[:, grain]
-    Y = np.where(label[:, None] >= 0, A[np.maximum(label, 0), grain], np.nan)
-    E = X - Y
-    lab = label >= 0
-    cx = cloud_stats(X[:, 0], X[:, 1]) if len(X) else None
-    cy = cloud_stats(Y[lab, 0], Y[lab, 1]) if lab.any() else None
-    visited, counts = np.unique(label[lab], return_counts=True)
-    return {"n_runs": int(tight.sizes["run"]), "n_converged": int(ok.sum()), "n_labelled": int(lab.sum()),
-            "visited": visited, "counts": counts,
-            "major": float(cx["major"]) if cx else np.nan, "minor": float(cx["minor"]) if cx else np.nan,
-            "ratio": float(cx["ratio"]) if cx else np.nan, "spread": float(cx["spread"]) if cx else np.nan,
-            "census_major": float(cy["major"]) if cy else np.nan, "census_minor": float(cy["minor"]) if cy else np.nan,
-            "rms_offset": float(np.sqrt(np.mean(np.sum(E[lab] ** 2, 1)))) if lab.any() else np.nan,
-            "max_offset": float(np.hypot(*E[lab].T).max()) if lab.any() else np.nan, "g": g,
-            "n_solutions": len(A)}
-
-
 def cloud_text(c, grain, tol, line_ratio):
-    """Markdown: what the chosen grain's cloud is, from :func:`cloud_against_census`."""
+    """Markdown: what the chosen grain's cloud is, from
+    :func:`ncd.figures.slope_analysis.cloud_against_census` (re-exported here)."""
     g = c["g"]
     head = (f"At {tol:.0e}, {c['n_converged']} of the {c['n_runs']} zero-guess runs converged; the cloud of "
             f"grain {grain} has RMS extents {c['major']:.2g} and {c['minor']:.2g} m/s² (minor/major "

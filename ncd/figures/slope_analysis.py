@@ -15,6 +15,9 @@
   grains may still roll on each other, so the fit measures how far from
   rigid the difference is) and the number of sticking links from every grain
   to the nearest switching contact;
+* :func:`cloud_against_census`: the chosen grain's cloud read through the
+  census of exact solutions (``census.nc``): which solutions its runs sit on,
+  and the iteration error left;
 * :func:`status_patterns` (for the census, :mod:`ncd.figures.census`): status
   patterns combining the changes seen between several solutions, cluster by
   cluster of switching contacts (:func:`contact_clusters`);
@@ -309,6 +312,43 @@ def status_patterns(statuses, contacts, n_mobile, max_patterns, rng):
             seen.add(key)
             uniq.append(p)
     return np.array(uniq, np.int8).reshape(-1, statuses.shape[1]), sw, len(clusters)
+
+
+def cloud_against_census(ens, census, grain, init="zero"):
+    """The chosen grain's cloud at the tightest tolerance, read through the census.
+
+    Every converged ``init`` run is labelled with the census solution whose whole
+    acceleration field lies within ``basin_tol |g|`` of its own (-1: none).  With
+    ``X`` the runs' accelerations of ``grain`` and ``Y`` those of their solutions,
+    ``E = X - Y``: the principal axes (RMS extents) of the cloud ``X`` differ from
+    those of ``Y`` by at most ``rms(E)`` (singular values are 1-Lipschitz in the
+    Frobenius norm), so the cloud is a set of solutions with the shape of ``Y``
+    (one point, a segment for two solutions, ...) blurred by the iteration error
+    ``E``.  Returns a dict of counts and axes (m s-2)."""
+    import yaml
+    tight = ens.sel(init=init).isel(tol=-1)
+    ok = tight.converged.values.astype(bool)
+    g = float(census.attrs["g"])
+    tol = float(yaml.safe_load(census.attrs["config_yaml"])["basin_tol"]) * g
+    A = np.stack([census.accel_x.values, census.accel_y.values], -1)
+    runs = np.stack([tight.accel_x.values, tight.accel_y.values], -1)[ok]
+    d = np.abs(runs[:, None] - A[None]).reshape(len(runs), len(A), -1).max(-1)
+    label = np.where(d.min(1) <= tol, d.argmin(1), -1)
+    X = runs[:, grain]
+    Y = np.where(label[:, None] >= 0, A[np.maximum(label, 0), grain], np.nan)
+    E = X - Y
+    lab = label >= 0
+    cx = cloud_stats(X[:, 0], X[:, 1]) if len(X) else None
+    cy = cloud_stats(Y[lab, 0], Y[lab, 1]) if lab.any() else None
+    visited, counts = np.unique(label[lab], return_counts=True)
+    return {"n_runs": int(tight.sizes["run"]), "n_converged": int(ok.sum()), "n_labelled": int(lab.sum()),
+            "visited": visited, "counts": counts,
+            "major": float(cx["major"]) if cx else np.nan, "minor": float(cx["minor"]) if cx else np.nan,
+            "ratio": float(cx["ratio"]) if cx else np.nan, "spread": float(cx["spread"]) if cx else np.nan,
+            "census_major": float(cy["major"]) if cy else np.nan, "census_minor": float(cy["minor"]) if cy else np.nan,
+            "rms_offset": float(np.sqrt(np.mean(np.sum(E[lab] ** 2, 1)))) if lab.any() else np.nan,
+            "max_offset": float(np.hypot(*E[lab].T).max()) if lab.any() else np.nan, "g": g,
+            "n_solutions": len(A)}
 
 
 def measures_dataset(traj, ens, cfg):
