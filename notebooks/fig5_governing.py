@@ -50,9 +50,9 @@
 # by every setting of that $\mu$ (the deposit, under gravity normal to the ground, does not
 # see $h$ or the slope). At fixed times after release each flow's next step is scanned as
 # Figure 2's scan does: zero-guess and warm-start NLGS runs with random review orders to a
-# natural-map residual $\le 10^{-8}$ with the grain accelerations settled (runs the sweep
-# budget leaves near the tolerance are finished by the active-set stage at that tolerance;
-# unconverged runs are counted and left out). Distinct end points (accelerations further apart
+# natural-map residual $\le 10^{-8}$ with the grain accelerations settled (unconverged runs
+# are counted and left out: the first steps after release, grains nearly at rest under heavy
+# forces, often exhaust the sweep budget). Distinct end points (accelerations further apart
 # than a threshold) are then polished on their contact statuses to a residual $\le 10^{-10}$:
 # a step is *indeterminate* when two exact solutions or more remain distinct, *determinate*
 # when every end point polishes to one solution, *unknown* otherwise. At every indeterminate
