@@ -38,7 +38,9 @@ from .local_solver import NO_CONTACT, SLIDE_BACKWARD, SLIDE_FORWARD, STICK
 FIRST_CHUNK = 50         # NLGS sweeps (at least; a quarter of those made) that measure NLGS's rate
 LP_SWEEPS = 50000        # NLGS goes on while its rate predicts finish_tol within this many sweeps
 ELASTIC = 1e3            # cost of a unit velocity violation (/ V) against a unit correction (/ S)
-ELASTIC_ROUNDS = 1       # status corrections by the elastic LP per attempt
+ELASTIC_ROUNDS = 0       # status corrections by the elastic LP per attempt (on the pile they did not make
+                         # the polyhedron non-empty and cost 2x a projection: off)
+MAX_ATTEMPTS = 3         # failed projections (an empty polyhedron costs 10-20 s on the pile) before NLGS alone
 MAX_CORRECTION = 0.05    # a projection moving the impulses by more (relative L1) is a jump: rejected
 SLACK = 1e-9             # a contact's violation (/ V) in the elastic LP above which its status changes
 LOG = logging.getLogger(__name__)
@@ -151,22 +153,24 @@ def switched(status, wrong, U):
 def polish(lp, W, q, mu, rho, scale, s0, status0, tol, more_sweeps, max_sweeps, sweeps0):
     """Finishing stage from the NLGS iterate ``s0`` (statuses ``status0``, after ``sweeps0`` sweeps).
 
-    NLGS goes on (``more_sweeps(k) -> (s, status)``; a first chunk measures its rate) while its rate predicts
-    ``finish_tol`` within :data:`LP_SWEEPS` sweeps; otherwise the
-    iterate is projected on the polyhedron of its statuses (:func:`ncd.finish_lp.project`);
-    if that is empty, an elastic LP (status conditions violated at a cost) names the contacts
-    whose status is wrong, they are switched (:func:`switched`), and the projection is tried again (:data:`ELASTIC_ROUNDS` times); a projection is accepted when
-    its natural-map residual is ``<= tol``.  If none is, NLGS goes on (chunks growing
-    4x) and the projection is tried again.  Returns ``(s, status, residual, lp_solves, ok, extra_sweeps, correction)``, the
-    best iterate when the sweep budget runs out; ``correction`` is the relative L1 size
-    ``|s - s_k|_1 / |s_k|_1`` of the accepted projection (0 when NLGS got there)."""
+    NLGS goes on (``more_sweeps(k) -> (s, status)``; a first chunk measures its rate)
+    while its rate predicts ``tol`` within :data:`LP_SWEEPS` sweeps.  Otherwise the
+    iterate is projected on the polyhedron of its statuses (:func:`ncd.finish_lp.project`;
+    if it is empty, :data:`ELASTIC_ROUNDS` elastic LPs name the contacts to switch,
+    :func:`switched`).  A projection is accepted when its natural-map residual is
+    ``<= tol`` and it moves the impulses by at most :data:`MAX_CORRECTION` (relative L1;
+    a larger move reaches another solution).  Else NLGS goes on (chunks growing 4x) and
+    the projection is tried again, :data:`MAX_ATTEMPTS` times at most.  Returns ``(s,
+    status, residual, lp_solves, ok, extra_sweeps, correction)``: the best iterate when
+    the sweep budget runs out; ``correction`` is ``|s - s_k|_1 / |s_k|_1`` of the
+    accepted projection (0 when NLGS got there)."""
     def residual(s):
         return relative_residual(s, (W @ s.ravel() + q).reshape(-1, 2), mu, rho, scale)
 
     s, status = s0, np.where(status0 > SLIDE_BACKWARD, STICK, status0).astype(np.int8)
     res = residual(s)
     best = (res, s, status)
-    solves, extra, chunk, rate = 0, 0, max(FIRST_CHUNK, sweeps0 // 4, 1), None
+    solves, attempts, extra, chunk, rate = 0, 0, 0, max(FIRST_CHUNK, sweeps0 // 4, 1), None
     while True:
         if res <= tol:
             return s, status, res, solves, True, extra, 0.0
@@ -175,7 +179,11 @@ def polish(lp, W, q, mu, rho, scale, s0, status0, tol, more_sweeps, max_sweeps, 
             k = min(chunk, max_sweeps - extra)                                # NLGS's rate first
         elif ahead <= LP_SWEEPS:
             k = int(min(np.ceil(1.2 * ahead) + 10, max_sweeps - extra))     # NLGS converges: let it
+        elif attempts >= MAX_ATTEMPTS:
+            k = min(chunk, max_sweeps - extra)
+            chunk *= 4
         else:
+            attempts += 1
             st_try = status
             for trial in range(1 + 2 * ELASTIC_ROUNDS):
                 # even trials: the projection; odd ones: the elastic LP, whose violated
