@@ -136,5 +136,6 @@ def test_tolerance_table_both_methods_reach_the_tolerance():
     assert ds.converged.values.all()
     assert (ds.residual.values <= ds.tol.values[None, None, :]).all()
     assert (ds.finish_rounds.sel(solver="nlgs").values == 0).all()
-    assert (ds.finish_rounds.sel(solver="nlgs+finish").values >= 1).all()
+    # NLGS converges at a steady rate on a dense packing: the finishing stage leaves it to NLGS (no LP)
+    assert (ds.finish_rounds.sel(solver="nlgs+finish").values == 0).all()
     assert ds.seconds.attrs["units"] == "s"
