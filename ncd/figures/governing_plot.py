@@ -69,8 +69,9 @@ def panel_flows(ax, flows, factor):
     grain's acceleration (right, / |g|) against one factor, 95 % bands over the seeds."""
     label, scale = FACTOR_LABEL[factor]
     t = factor_table(flows, factor, "indeterminate")
-    ax.errorbar(t[:, 0], t[:, 1], yerr=np.nan_to_num(t[:, 2]), marker="o", color="C0", capsize=3,
-                label="indeterminate steps")
+    band = np.nan_to_num(t[:, 2])
+    ax.errorbar(t[:, 0], t[:, 1], yerr=[np.minimum(band, t[:, 1]), np.minimum(band, 1 - t[:, 1])], marker="o",
+                color="C0", capsize=3, label="indeterminate steps (band clipped to [0, 1])")
     u = factor_table(flows, factor, "unknown")
     ax.plot(u[:, 0], u[:, 1], "x:", color="0.5", label="unknown (unconverged)")
     ax.set(xscale=scale, xlabel=label, ylabel="fraction of scanned steps", ylim=(-0.02, 1.02),
@@ -82,7 +83,9 @@ def panel_flows(ax, flows, factor):
     sp = factor_table(flows, factor, "spread")
     ok = np.isfinite(sp[:, 1]) & (sp[:, 1] > 0)
     if ok.any():
-        tw.errorbar(sp[ok, 0], sp[ok, 1], yerr=np.nan_to_num(sp[ok, 2]), marker="s", color="C3", capsize=3)
+        half = np.nan_to_num(sp[ok, 2])
+        low = np.minimum(half, 0.9 * sp[ok, 1])          # a log axis: the band stops above zero
+        tw.errorbar(sp[ok, 0], sp[ok, 1], yerr=[low, half], marker="s", color="C3", capsize=3)
         tw.set_yscale("log")
     tw.set_ylabel("mean largest spread / |g|", color="C3")
     ax.legend(fontsize=7, loc="upper left")
@@ -101,7 +104,7 @@ def panel_line(ax, flows):
     c = line_counts(flows)
     ax.set(xticks=x, xticklabels=["point", "line", "area"], ylabel="indeterminate steps",
            title=f"(d) why a line: hypothesis holds at {c['holds']} of {c['steps']}")
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=7, loc="upper left")
 
 
 def figure(ds, flows=None):
