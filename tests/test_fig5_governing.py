@@ -275,3 +275,20 @@ def test_flow_tables(flows):
     c = gs.line_counts(flows)
     assert c["steps"] == int((flows.indeterminate.values == 1).sum()) == sum(c["rank"])
     assert c["holds"] <= c["steps"] and c["line_and_predicted"] + c["line_not_predicted"] == c["rank"][1]
+
+
+def test_flow_settings_one_factor_at_a_time():
+    from ncd.figures import governing_flow as gf
+    f = dict(base={"mu": 0.5, "h": 5e-4, "slope_deg": 24.0}, mu=[0.1, 0.3, 0.8], h=[2e-4, 2e-3], slope_deg=[20.0],
+             duration=0.05, scan_every=0.005)
+    t = gf.settings_table(f)
+    assert len(t["mu"]) == 7 and t["factor"].tolist() == [0, 1, 1, 1, 2, 2, 3]
+    # each extra setting changes exactly one parameter of the base
+    changed = (t["mu"] != 0.5).astype(int) + (t["h"] != 5e-4) + (t["slope_deg"] != 24.0)
+    assert changed.tolist() == [0, 1, 1, 1, 1, 1, 1]
+    np.testing.assert_allclose(gf.deposit_mus(f), [0.1, 0.3, 0.5, 0.8])
+    np.testing.assert_allclose(gf.scan_times(f), 0.005 * np.arange(1, 11))
+    with pytest.raises(ncd.InputError, match="flows.h"):
+        gf.settings_table(dict(f, h=[5e-4]))
+    with pytest.raises(ncd.InputError, match="duration"):
+        gf.scan_times(dict(f, duration=0.001))
