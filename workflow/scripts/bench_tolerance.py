@@ -36,5 +36,7 @@ ds = xr.Dataset({k: (("problem", "order", "solver", "tol"), np.array(v), {"units
                  for k, v in out.items()},
                 coords={"problem": list(problems), "order": np.arange(cfg["orders"]), "solver": list(METHODS),
                         "tol": cfg["tolerances"]})
+ds["problem"].attrs.update(units="1", long_name="step problem: the pile's final state, fig2's investigated step")
+ds["order"].attrs.update(units="1", long_name="review order: 0 identity, k > 0 permutation of rng((k, root_seed))")
 ds.attrs.update(provenance(cfg, **environment()))
 write_dataset(ds, snakemake.output.problems)  # noqa: F821
