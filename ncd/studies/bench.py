@@ -277,7 +277,7 @@ def tolerance_table(cfg, log=None):
                              out["seconds"][i, j, k], r.sweeps, r.residual)
     units = {"seconds": ("s", "wall time to reach the tolerance"), "residual": ("1", "relative natural-map residual"),
              "sweeps": ("1", "NLGS sweeps"), "converged": ("1", "residual <= tolerance (1) or not (0)"),
-             "finish_rounds": ("1", "active-set rounds of the finishing stage")}
+             "finish_rounds": ("1", "rounds of the finishing stage (LP projections onto a status set)")}
     return xr.Dataset({k: (("size", "solver", "tol"), v, {"units": units[k][0], "long_name": units[k][1]})
                        for k, v in out.items()},
                       coords={"size": sizes, "solver": methods, "tol": tols})

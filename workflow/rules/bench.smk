@@ -134,6 +134,7 @@ rule bench_notebook:
         core="results/bench/core.nc",
         sweeps="results/bench/sweeps.nc",
         tolerance="results/bench/tolerance.nc",
+        tolerance_problems="results/bench/tolerance_problems.nc",
         ensemble="results/bench/ensemble.nc",
         peer="results/bench/peer.nc",
         rules="results/bench/rules.nc",
