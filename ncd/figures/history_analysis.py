@@ -107,16 +107,19 @@ def permutation_p(dip_a, dip_b, profiles_a, profiles_b, xi, center, flank, rng, 
 
 
 def exact_arrays(exact, hist, n, shape):
-    """``(dev_min, dev_max, history_outside, computed)`` over (history, pile, flank, position)
-    from ``exact = {(history, member): dataset of ncd.figures.history_exact}``; NaN where absent."""
+    """``(dev_min, dev_max, history_outside, computed, confirmed)`` over (history, pile, flank,
+    position) from ``exact = {(history, member): dataset of ncd.figures.history_exact}``; NaN
+    (or 0) where absent."""
     lo, hi, out = (np.full((len(hist), n) + shape, np.nan) for _ in range(3))
     done = np.zeros((len(hist), n), np.int8)
+    confirmed = np.zeros((len(hist), n) + shape, np.int8)
     for (h, m), e in (exact or {}).items():
         i = hist.index(h)
         lo[i, m], hi[i, m] = e["exact_deviation_min"].values, e["exact_deviation_max"].values
         out[i, m] = e["history_outside"].values
+        confirmed[i, m] = e["polygon_exact"].values
         done[i, m] = 1
-    return lo, hi, out, done
+    return lo, hi, out, done, confirmed
 
 
 def ensemble_dataset(cfg, files, exact=None):
@@ -148,7 +151,7 @@ def ensemble_dataset(cfg, files, exact=None):
     ang = stack("cut_angle")
     q = np.asarray(a["cut_positions"], float)
     boot_med = np.median(dev[:, idx], axis=2)     # (history, B, flank, position)
-    ex_lo, ex_hi, ex_out, ex_done = exact_arrays(exact, hist, n, dev.shape[2:])
+    ex_lo, ex_hi, ex_out, ex_done, ex_conf = exact_arrays(exact, hist, n, dev.shape[2:])
     one = lambda dims, v, u, ln: (dims, v, {"units": u, "long_name": ln})  # noqa: E731
     H, P, K, X, F, Q = "history", "pile", "kernel", "xi", "flank", "cut_position"
     out = xr.Dataset(
@@ -200,6 +203,8 @@ def ensemble_dataset(cfg, files, exact=None):
             "exact_history_outside": one((H, P, F, Q), ex_out, "N", "distance of the history resultant "
                                          "outside the exact polygon (NaN: not computed)"),
             "exact_computed": one((H, P), ex_done, "1", "exact angle ranges computed for this pile"),
+            "exact_confirmed": one((H, P, F, Q), ex_conf, "1", "exact polygon confirmed edge by edge (1); 0: LP "
+                                   "budget exhausted (an inner polygon: the range is a lower bound) or not computed"),
         },
         coords={H: hist, P: np.arange(n), K: widths, X: xi, F: ["left", "right"], Q: q},
         attrs={"level": a["level"], "bootstrap": B, "permutations": a["permutations"],

@@ -136,7 +136,8 @@ def summary(an):
                           exact_width_max=float(np.nanmax(width)),
                           exact_all_positive=float(np.mean(e.exact_deviation_min.values > 0)),
                           exact_all_negative=float(np.mean(e.exact_deviation_max.values < 0)),
-                          exact_undefined=float(np.mean(np.isnan(width))))
+                          exact_undefined=float(np.mean(np.isnan(width))),
+                          exact_confirmed=float(e.exact_confirmed.mean()) if "exact_confirmed" in e else np.nan)
     out["diff"] = float(an.dip_diff.sel(kernel=k0))
     out["diff_lo"], out["diff_hi"] = float(an.dip_diff_lo.sel(kernel=k0)), float(an.dip_diff_hi.sel(kernel=k0))
     out["p"] = {float(k): float(an.dip_diff_p.sel(kernel=k)) for k in an.kernel.values}
