@@ -1,6 +1,7 @@
 # ncd: reproduce the figures of Moreau (2005), "Indetermination in the numerical
 # simulation of granular systems".  `snakemake -j2` builds every figure;
 # `snakemake -j2 fig1_wedged` builds one figure and only its inputs.
+import os
 import sys
 from pathlib import Path
 
@@ -9,6 +10,12 @@ from snakemake.utils import min_version, validate
 min_version("8.0")
 
 configfile: str(Path(workflow.basedir) / "config.yaml")
+
+# One BLAS thread per job (inherited by every job's interpreter): with -j2 on 2 cores the
+# default OpenBLAS threads oversubscribe the cores (fig5's dense SVDs ran 6-18x slower), and
+# a fixed thread count keeps dense linear algebra's bits the same whatever -j.
+for _var in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
 
 validate(config, str(Path(workflow.basedir) / "workflow/schemas/config.schema.yaml"))
 

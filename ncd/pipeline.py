@@ -26,7 +26,8 @@ def start(snakemake):
     handler = logging.FileHandler(snakemake.log[0], mode="w") if len(snakemake.log) else logging.StreamHandler()
     handler.setFormatter(logging.Formatter("%(name)s: %(message)s"))
     logger.addHandler(handler)
-    logger.info("rule %s, threads %d (numba %d)", snakemake.rule, snakemake.threads, numba.get_num_threads())
+    logger.info("rule %s, threads %d (numba %d, OPENBLAS_NUM_THREADS=%s)", snakemake.rule, snakemake.threads,
+                numba.get_num_threads(), os.environ.get("OPENBLAS_NUM_THREADS", "unset"))
     log_uncaught(logger)
     return logger
 
