@@ -52,7 +52,7 @@ NCD_MODULES = {
     "fig5_governing": ["figures/__init__.py", "figures/equilibrium.py", "figures/governing.py",
                        "figures/governing_exact.py", "figures/governing_plot.py", "figures/governing_flow.py",
                        "figures/governing_line.py", "figures/slope.py", "figures/slope_analysis.py",
-                       "figures/census.py"],
+                       "figures/census.py", "figures/governing_summary.py"],
     "stability": ["studies/__init__.py", "studies/stability.py", "studies/scenes.py"],
     "error_vs_runtime": ["studies/__init__.py", "studies/work_precision.py", "studies/scenes.py"],
     "bench": ["studies/__init__.py", "studies/bench.py", "studies/peer.py", "studies/c_sweep.c",
