@@ -26,6 +26,7 @@ solutions always span one direction: the test has content from three solutions o
 import numpy as np
 
 from ..finish import status_system
+from .slope_analysis import rigid_clusters
 
 STATUS_NAMES = ("open", "stick", "slide forward", "slide backward")
 
@@ -66,23 +67,13 @@ def moving_clusters(delta, body_a, body_b, active, threshold):
     delta = np.asarray(delta, float)
     n = delta.shape[1]
     moving = (np.hypot(delta[..., 0], delta[..., 1]) > threshold).any(axis=0)
-    parent = np.arange(n)
-
-    def find(i):
-        while parent[i] != i:
-            parent[i] = parent[parent[i]]
-            i = parent[i]
-        return i
-
-    for a, b, on in zip(body_a, body_b, active):
-        if on and 0 <= b < n and moving[a] and moving[b]:
-            ra, rb = find(a), find(b)
-            if ra != rb:
-                parent[max(ra, rb)] = min(ra, rb)
+    a, b = np.asarray(body_a), np.asarray(body_b)
+    inside = (b >= 0) & (b < n)
+    links = np.zeros(len(a), bool)
+    links[inside] = np.asarray(active, bool)[inside] & moving[a[inside]] & moving[b[inside]]
     labels = -np.ones(n, np.int64)
-    roots = np.array([find(i) for i in np.nonzero(moving)[0]], np.int64)
-    if len(roots):
-        labels[moving] = np.unique(roots, return_inverse=True)[1]
+    if moving.any():   # components of the moving grains, numbered by their smallest grain
+        labels[moving] = np.unique(rigid_clusters(n, a, b, links)[moving], return_inverse=True)[1]
     return moving, labels
 
 
