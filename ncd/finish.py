@@ -12,9 +12,9 @@ solutions form a polyhedron (2-D Coulomb cones are polyhedral,
 2. otherwise projects the iterate ``s_k`` on the polyhedron of its statuses: the
    point ``s`` nearest to ``s_k`` in the L1 norm (an LP, HiGHS), a small
    correction that stays on the solution NLGS is approaching (no jump to another
-   one of an indeterminate problem);  if that polyhedron is empty, an elastic LP
-   (the statuses' velocity conditions violated at a cost) can name the contacts whose
-   status is wrong, switched by the sign of their violation (:data:`ELASTIC_ROUNDS`, off);
+   one of an indeterminate problem);  an elastic LP naming the contacts whose status
+   is wrong (``ncd.finish_lp.project(elastic=...)``) was tried on the pile: it never made
+   the polyhedron non-empty and cost twice a projection, so it is not used;
 3. accepts the projection when its relative natural-map residual is ``<= finish_tol``
    and it moves the impulses by at most :data:`MAX_CORRECTION` (relative L1);
    otherwise NLGS goes on (chunks growing 4x, within the sweep budget) and 2 is tried
@@ -45,12 +45,8 @@ from .local_solver import NO_CONTACT, SLIDE_BACKWARD, SLIDE_FORWARD, STICK
 
 FIRST_CHUNK = 50         # NLGS sweeps (at least; a quarter of those made) that measure NLGS's rate
 LP_SWEEPS = 50000        # NLGS goes on while its rate predicts finish_tol within this many sweeps
-ELASTIC = 1e3            # cost of a unit velocity violation (/ V) against a unit correction (/ S)
-ELASTIC_ROUNDS = 0       # status corrections by the elastic LP per attempt (on the pile they did not make
-                         # the polyhedron non-empty and cost 2x a projection: off)
 MAX_ATTEMPTS = 3         # failed projections (an empty polyhedron costs 10-20 s on the pile) before NLGS alone
 MAX_CORRECTION = 0.05    # a projection moving the impulses by more (relative L1) is a jump: rejected
-SLACK = 1e-9             # a contact's violation (/ V) in the elastic LP above which its status changes
 LOG = logging.getLogger(__name__)
 REFINE = 30              # iterated-Tikhonov refinements of one minimum-norm correction (census)
 
@@ -143,29 +139,13 @@ def project_statuses(W, q, mu, s0, status):
     return (P @ (x0 + min_norm_solve(K, r))).reshape(-1, 2)
 
 
-def switched(status, wrong, U):
-    """New statuses of the ``wrong`` contacts from the sign of the violated velocity at the
-    elastic LP's point: closed with ``U_n > 0``: open; open (``U_n < 0``): stick; stick with
-    ``U_t > 0``: slide forward (``U_t < 0``: backward); sliding the wrong way: stick."""
-    new = status.copy()
-    closed = status != NO_CONTACT
-    opening = wrong & closed & (U[:, 0] > 0)
-    new[opening] = NO_CONTACT
-    new[wrong & ~closed] = STICK
-    tang = wrong & closed & ~opening
-    new[tang & (status == STICK)] = np.where(U[tang & (status == STICK), 1] > 0, SLIDE_FORWARD, SLIDE_BACKWARD)
-    new[tang & (status != STICK)] = STICK
-    return new.astype(np.int8)
-
-
 def polish(lp, W, q, mu, rho, scale, s0, status0, tol, more_sweeps, max_sweeps, sweeps0):
     """Finishing stage from the NLGS iterate ``s0`` (statuses ``status0``, after ``sweeps0`` sweeps).
 
     NLGS goes on (``more_sweeps(k) -> (s, status)``; a first chunk measures its rate)
     while its rate predicts ``tol`` within :data:`LP_SWEEPS` sweeps.  Otherwise the
-    iterate is projected on the polyhedron of its statuses (:func:`ncd.finish_lp.project`;
-    if it is empty, :data:`ELASTIC_ROUNDS` elastic LPs name the contacts to switch,
-    :func:`switched`).  A projection is accepted when its natural-map residual is
+    iterate is projected on the polyhedron of its statuses (:func:`ncd.finish_lp.project`).
+    A projection is accepted when its natural-map residual is
     ``<= tol`` and it moves the impulses by at most :data:`MAX_CORRECTION` (relative L1;
     a larger move reaches another solution).  Else NLGS goes on (chunks growing 4x) and
     the projection is tried again, :data:`MAX_ATTEMPTS` times at most.  Returns ``(s,
@@ -192,34 +172,20 @@ def polish(lp, W, q, mu, rho, scale, s0, status0, tol, more_sweeps, max_sweeps, 
             chunk *= 4
         else:
             attempts += 1
-            st_try = status
-            for trial in range(1 + 2 * ELASTIC_ROUNDS):
-                # even trials: the projection; odd ones: the elastic LP, whose violated
-                # contacts are switched by the sign of their violation
-                solves += 1
-                cand, _, info = project(lp, s, st_try, elastic=ELASTIC if trial % 2 else 0.0)
-                r = np.inf if cand is None else residual(cand)
-                LOG.debug("sweeps %d residual %.2e: LP %d (%s, %d iterations) -> %.2e",
-                          sweeps0 + extra, res, trial, info["status"], info["iterations"], r)
-                if cand is None:
-                    if trial % 2:
-                        break
-                    continue
+            solves += 1
+            cand, _, info = project(lp, s, status)
+            r = np.inf if cand is None else residual(cand)
+            LOG.debug("sweeps %d residual %.2e: LP (%s, %d iterations) -> %.2e",
+                      sweeps0 + extra, res, info["status"], info["iterations"], r)
+            if cand is not None:
                 region = natural_map(cand, (W @ cand.ravel() + q).reshape(-1, 2), mu, rho)[1]
+                corr = info["correction"] / max(np.abs(s).sum(), 1e-300)
                 if r < best[0] and info["correction"] <= MAX_CORRECTION * np.abs(s).sum():
                     best = (r, cand, region)
-                corr = info["correction"] / max(np.abs(s).sum(), 1e-300)
                 if r <= tol and corr <= MAX_CORRECTION:
                     return cand, region, r, solves, True, extra, corr
-                if corr > MAX_CORRECTION:
-                    break        # another solution, far from the iterate: more sweeps first
-                if trial % 2:
-                    wrong = info["slack"] > SLACK
-                    if not wrong.any():
-                        break
-                    st_try = switched(st_try, wrong, (W @ cand.ravel() + q).reshape(-1, 2))
-                elif trial:
-                    break        # the switched statuses' polyhedron holds no solution either
+                # else: an empty polyhedron, a residual above tol, or a jump to another
+                # solution far from the iterate: more sweeps first
             k = min(chunk, max_sweeps - extra)
             chunk *= 4
         if k <= 0:
