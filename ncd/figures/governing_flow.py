@@ -149,8 +149,6 @@ def scene_of_deposit(dep, cfg, mu, slope_deg):
 
 def scan_step(scene, h, sc, members):
     """Zero-guess and warm-start runs of the next step -> (dict of SCAN_VARS and LINE_VARS)."""
-    from .census import StepSolutions
-
     problem = prepare_step(scene, h)
     settings = SolverSettings(tol=sc["tol"], max_sweeps=sc["max_sweeps"], check_every=sc["check_every"],
                               finish=sc["finish"], finish_tol=sc["finish_tol"])
