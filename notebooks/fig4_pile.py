@@ -375,10 +375,13 @@ save(fig, out, dpi=130, bbox_inches="tight")
 # The equilibrium forces of the final arrangement form the polytope
 # $A \cap C$; every quantity above is a linear map of them, so its exact range
 # is given by linear programs (HiGHS, `exact.nc`): the projection of
-# $A \cap C$ on the plane of a cut resultant (a polygon, from 180 support
-# directions refined edge by edge), the range of the resultant's angle across
-# every cut, and the range of the ground pressure. Below, the numbers of this
-# run, then the clouds of the converged rest states inside their polygons.
+# $A \cap C$ on the plane of a cut resultant for the default and shifted cuts
+# (a polygon, from 180 support directions refined edge by edge); the range of
+# the resultant's angle across every cut, a linear-fractional program
+# $\min / \max\ q(r)/p(r)$ over $A \cap C$ solved by Dinkelbach's iteration
+# (a few LPs per end, each with a certified error bound, no polygon needed);
+# and the range of the ground pressure. Below, the numbers of this run, then
+# the clouds of the converged rest states inside their polygons.
 
 # %%
 Markdown(pe.exact_text(exact, ens, cuts))

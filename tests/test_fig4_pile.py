@@ -251,18 +251,33 @@ def test_every_run_is_classified(data):
 
 
 def test_exact_polygons_contain_every_converged_rest_run(data):
-    """Every rest run's resultant lies inside the exact polygon of its cut to 1e-8 of the
-    pile's weight, for every cut; the history resultant too (to the equilibrium test's accuracy)."""
+    """Every rest run's resultant lies inside the exact polygon of the default and shifted
+    cuts to 1e-8 of the pile's weight; at every cut (scan cuts included) its angle lies in
+    the exact angle range and its F_y in the exact F_y range; the history resultant too
+    (to the equilibrium test's accuracy).  The angle ranges (Dinkelbach) agree with the
+    polygons' own angles where both exist."""
     ens, ex = data["ensemble"], data["exact"]
     W = ex.attrs["weight"]
     rest = pile_exact.rest_mask(ens)
     assert ex.sizes["cut"] == data["cuts"].sizes["cut"]
-    for k in range(ex.sizes["cut"]):
+    poly = ex.n_vertices.values > 0
+    assert poly[:3].all() and not poly[3:].any() and ex.sizes["cut"] > 10
+    for k in np.nonzero(poly)[0]:
         _, out, cov = pile_exact.cloud_in_polygon(ex, ens, k, rest)
         assert out.max(initial=0.0) <= 1e-8 * W, f"cut {k}: {out.max() / W:.2e} W outside"
         assert 0.0 <= cov <= 1.0 + 1e-9
-    assert ex.history_outside.max() <= 1e-6 * W
-    assert ex.exact.values.all() and ex.n_lp[0] >= yaml.safe_load(ex.attrs["config_yaml"])["exact"]["n_dirs"]
+    outer = data["cuts"].outer.values
+    fx, fy = ens.cut_force_x.values[rest], ens.cut_force_y.values[rest]
+    phi = np.degrees(np.arctan2(-fy, outer * fx))
+    lo, hi = ex.angle_min.values, ex.angle_max.values
+    ok = np.isfinite(lo)
+    assert ok.mean() > 0.5 and np.all(ex.angle_bound.values[ok] <= 1e-6)
+    above = (phi[:, ok] - lo[ok] + 1e-6) % 360.0            # angles compared modulo 360 degrees
+    assert np.all(above <= hi[ok] - lo[ok] + 2e-6)
+    assert np.all(fy >= ex.fy_min.values - 1e-8 * W) and np.all(fy <= ex.fy_max.values + 1e-8 * W)
+    assert np.nanmax(ex.history_outside.values) <= 1e-6 * W and np.nanmax(ex.history_angle_outside.values) <= 1e-6
+    assert ex.attrs["polygon_angle_gap"] <= 1e-6
+    assert (ex.exact.values[poly] == 1).all() and ex.n_lp[0] >= yaml.safe_load(ex.attrs["config_yaml"])["exact"]["n_dirs"]
 
 
 def test_lp_vertices_are_admissible_and_the_dip_verdict_follows_the_numbers(data):

@@ -181,3 +181,52 @@ def test_three_grain_pile_polygon_equals_the_hull_of_enumerated_vertices():
     lo, hi = es.interval(fy)
     assert hi - lo > 1e-3 * weight
     assert abs(lo - (V @ fy).min()) <= 1e-9 * weight and abs(hi - (V @ fy).max()) <= 1e-9 * weight
+
+
+@pytest.mark.parametrize("outer", [1, -1])
+def test_angle_range_equals_the_angles_of_the_enumerated_vertices(outer):
+    """ExactSet.angle_range (Dinkelbach's iteration, a few LPs) against brute force: the
+    angle range of the enumerated vertices of a three-grain pile's A ∩ C under the left
+    ground disc's force, whatever the reference direction (the vertices' own angles, a
+    direction 100 degrees off that does not separate the image from 0, none)."""
+    scene = three_grain_pile(0.3)
+    c, H, F = balanced(scene)
+    V = vertices_by_enumeration(H, F, c.mu)
+    es = ExactSet(H, F, c.mu)
+    left = int(np.nonzero((c.body_a == 0) & (c.body_b == 3))[0][0])
+    L = np.zeros((2, 2 * c.n))
+    for row in (0, 1):
+        L[row, 2 * left], L[row, 2 * left + 1] = c.normal[left, row], c.tangent[left, row]
+    P = V @ L.T
+    phi = np.degrees(np.arctan2(-P[:, 1], outer * P[:, 0]))
+    assert phi.max() - phi.min() > 5.0                       # a range worth testing
+    for ref in (float(phi.mean()), float(phi.mean()) + 100.0, None):
+        r = es.angle_range(L, outer, ref=ref)
+        assert abs(r["lo"] - phi.min()) <= 1e-8 and abs(r["hi"] - phi.max()) <= 1e-8
+        assert r["bound"] <= 1e-8 and r["n_lp"] <= 30
+        # the two extreme points are admissible and have the extreme angles
+        eq, co = es.fp.violations(r["points"])
+        assert eq.max() <= 1e-9 and co.max() <= 1e-9
+        g = r["points"] @ L.T
+        np.testing.assert_allclose(np.degrees(np.arctan2(-g[:, 1], outer * g[:, 0])), [r["lo"], r["hi"]], atol=1e-7)
+
+
+def test_angle_range_is_undefined_when_the_image_surrounds_zero():
+    """A contact force that can vanish (its polygon contains the origin): no angle range,
+    as resultant_angle of the exact polygon says."""
+    scene = small_pile()
+    c, H, F = balanced(scene)
+    es = ExactSet(H, F, c.mu)
+    seen = {True: 0, False: 0}
+    for k in range(c.n):
+        L = np.zeros((2, 2 * c.n))
+        for row in (0, 1):
+            L[row, 2 * k], L[row, 2 * k + 1] = c.normal[k, row], c.tangent[k, row]
+        ref = resultant_angle(es.polygon(L, n_dirs=24)["vertices"], 1)
+        r = es.angle_range(L, 1)
+        seen[bool(np.isnan(ref[0]))] += 1
+        if np.isnan(ref[0]):
+            assert np.isnan(r["lo"]) and np.isnan(r["hi"])
+        else:
+            assert abs(r["lo"] - ref[0]) <= 1e-8 and abs(r["hi"] - ref[1]) <= 1e-8
+    assert seen[True] >= 2 and seen[False] >= 2

@@ -28,6 +28,8 @@ from .history import HISTORIES, ground_forces
 from .pile import equilibrium_problem, final_scene
 from .sources import mean_diameter
 
+CERTIFIED_DEG = 1e-6   # an exact angle range is certified when its error bound (angle_bound) is below this
+
 
 def stress_profile(x, fy, weight, L, xi, width):
     """Kernel-averaged ground stress at ``xi`` (units of ``W / (2 L)``); ``width`` in m."""
@@ -117,7 +119,8 @@ def exact_arrays(exact, hist, n, shape):
         i = hist.index(h)
         lo[i, m], hi[i, m] = e["exact_deviation_min"].values, e["exact_deviation_max"].values
         out[i, m] = e["history_outside"].values
-        confirmed[i, m] = e["polygon_exact"].values
+        bound = e["angle_bound"].values
+        confirmed[i, m] = np.isfinite(bound) & (bound <= CERTIFIED_DEG)
         done[i, m] = 1
     return lo, hi, out, done, confirmed
 
@@ -200,11 +203,11 @@ def ensemble_dataset(cfg, files, exact=None):
                                        "resultant angle minus the flank slope (NaN: not computed)"),
             "exact_deviation_max": one((H, P, F, Q), ex_hi, "degree", "exact maximum over A ∩ C of the cut "
                                        "resultant angle minus the flank slope (NaN: not computed)"),
-            "exact_history_outside": one((H, P, F, Q), ex_out, "N", "distance of the history resultant "
-                                         "outside the exact polygon (NaN: not computed)"),
+            "exact_history_outside": one((H, P, F, Q), ex_out, "degree", "angle of the history resultant "
+                                         "outside the exact angle range (NaN: not computed)"),
             "exact_computed": one((H, P), ex_done, "1", "exact angle ranges computed for this pile"),
-            "exact_confirmed": one((H, P, F, Q), ex_conf, "1", "exact polygon confirmed edge by edge (1); 0: LP "
-                                   "budget exhausted (an inner polygon: the range is a lower bound) or not computed"),
+            "exact_confirmed": one((H, P, F, Q), ex_conf, "1", "exact angle range certified to 1e-6 degree (1); "
+                                   "0: not computed, or the admissible resultants surround zero (no range)"),
         },
         coords={H: hist, P: np.arange(n), K: widths, X: xi, F: ["left", "right"], Q: q},
         attrs={"level": a["level"], "bootstrap": B, "permutations": a["permutations"],

@@ -1,12 +1,13 @@
 """Exact angle ranges at the arching cuts of a pile of fig4_history (issue 16, item 3).
 
-For one pile file, the set A ∩ C of its final configuration (every force state that
-balances the weights within the Coulomb cones, :class:`ncd.figures.pile_exact.ExactSet`,
-HiGHS LPs) is projected onto the resultant across each arching cut of
-:func:`ncd.figures.history_analysis.pile_measures` (``x = ± q L``, whole column): the
-exact polygon of admissible resultants, hence the exact range of the resultant's angle
-below the horizontal and of its deviation from the pile's flank slope.  The history
-forces' angle lies in that range (checked: ``history_outside``).
+For one pile file, over the set A ∩ C of its final configuration (every force state
+that balances the weights within the Coulomb cones, :class:`ncd.exact_set.ExactSet`,
+HiGHS LPs), the exact range of the angle below the horizontal of the resultant across
+each arching cut of :func:`ncd.figures.history_analysis.pile_measures` (``x = ± q L``,
+whole column): a linear-fractional program, solved by Dinkelbach's iteration with a
+certified error bound (``angle_bound``), hence the range of its deviation from the
+pile's flank slope.  The history forces' angle lies in that range (checked:
+``history_outside``).
 """
 import time
 
@@ -15,7 +16,8 @@ import xarray as xr
 
 from . import cuts as cm
 from .history_analysis import norm_length
-from .pile_exact import ExactSet, pile_problem, resultant_angle
+from ..exact_set import ExactSet
+from .pile_exact import pile_problem
 
 
 def cut_specs(cfg, ds):
@@ -29,8 +31,9 @@ def cut_specs(cfg, ds):
 
 
 def exact_ranges(cfg, ds, log=None):
-    """Dataset of one pile: per flank and cut position the exact angle range over A ∩ C,
-    the history angle and whether the polygon was confirmed edge by edge."""
+    """Dataset of one pile: per flank and cut position the exact angle range over A ∩ C
+    (certified, :meth:`ExactSet.angle_range`), the exact range of the vertical component
+    and the history angle."""
     e = cfg["exact"]
     t0 = time.perf_counter()
     scene, c, H, F, mu = pile_problem(cfg, ds)
@@ -40,32 +43,31 @@ def exact_ranges(cfg, ds, log=None):
     C, _ = cm.cut_matrix(c, scene.pos, nm, specs)
     hist = (C @ np.column_stack([ds["force_n"].values, ds["force_t"].values]).ravel()).reshape(-1, 2)
     phi_hist = np.degrees(np.arctan2(-hist[:, 1], outer * hist[:, 0]))
-    amin, amax, exact, n_lp, fy_max = [], [], [], [], []
-    from ..polytope import outside_distance
-    inside = []
+    amin, amax, bound, n_lp, fy_max = [], [], [], [], []
     for k in range(len(specs)):
-        p = es.polygon(C[2 * k: 2 * k + 2], n_dirs=e["n_dirs"], tol=e["tol"], max_lp=e["max_lp"])
-        lo, hi = resultant_angle(p["vertices"], outer[k])
-        amin.append(lo)
-        amax.append(hi)
-        exact.append(p["exact"])
-        n_lp.append(p["n_lp"])
-        fy_max.append(p["vertices"][:, 1].max())
-        inside.append(outside_distance(hist[k:k + 1], p["vertices"])[0])
+        n0 = es.n_lp
+        rng = es.angle_range(C[2 * k: 2 * k + 2], outer[k], ref=phi_hist[k], tol=e["angle_tol"])
+        amin.append(rng["lo"])
+        amax.append(rng["hi"])
+        bound.append(rng["bound"])
+        fy_max.append(es.interval(C[2 * k + 1].toarray().ravel())[1])
+        n_lp.append(es.n_lp - n0)
+    amin, amax = np.asarray(amin), np.asarray(amax)
+    outside = np.maximum(np.maximum(amin - phi_hist, phi_hist - amax), 0.0)
     if log is not None:
         log.info("%s pile %d: %d cuts, %d LPs, %.1f s", ds.attrs["history"], ds.attrs["member"], len(specs),
                  es.n_lp, time.perf_counter() - t0)
     shape = (2, -1)
     fq = ("flank", "cut_position")
     # deviations from the flank slope, the lower end wrapped to (-180, 180] as the analysis' deviations
-    dev_lo = (np.asarray(amin) - slope + 180.0) % 360.0 - 180.0
-    dev_hi = dev_lo + (np.asarray(amax) - np.asarray(amin))
+    dev_lo = (amin - slope + 180.0) % 360.0 - 180.0
+    dev_hi = dev_lo + (amax - amin)
     q = np.asarray(cfg["analysis"]["cut_positions"], float)
     out = xr.Dataset(
         {
-            "exact_angle_min": (fq, np.reshape(amin, shape), {"units": "degree", "long_name":
+            "exact_angle_min": (fq, amin.reshape(shape), {"units": "degree", "long_name":
                                 "smallest angle below the horizontal (outward) of an admissible cut resultant"}),
-            "exact_angle_max": (fq, np.reshape(amax, shape), {"units": "degree", "long_name":
+            "exact_angle_max": (fq, amax.reshape(shape), {"units": "degree", "long_name":
                                 "largest angle below the horizontal (outward) of an admissible cut resultant"}),
             "exact_deviation_min": (fq, dev_lo.reshape(shape), {"units": "degree",
                                     "long_name": "smallest admissible angle minus the flank slope"}),
@@ -73,14 +75,13 @@ def exact_ranges(cfg, ds, log=None):
                                     "long_name": "largest admissible angle minus the flank slope"}),
             "history_angle": (fq, phi_hist.reshape(shape), {"units": "degree", "long_name":
                               "angle of the history forces' cut resultant"}),
-            "history_outside": (fq, np.reshape(inside, shape), {"units": "N", "long_name":
-                                "distance of the history resultant outside the exact polygon"}),
+            "history_outside": (fq, outside.reshape(shape), {"units": "degree", "long_name":
+                                "angle of the history resultant outside the exact angle range"}),
             "exact_fy_max": (fq, np.reshape(fy_max, shape), {"units": "N", "long_name":
                              "largest vertical component of an admissible resultant (< 0: every state arches)"}),
-            "polygon_exact": (fq, np.reshape(exact, shape).astype(np.int8), {
-                "units": "1", "long_name": "polygon confirmed edge by edge (1) or LP budget exhausted (0)",
-                "flag_values": np.array([0, 1], np.int8), "flag_meanings": "budget_exhausted confirmed"}),
-            "n_lp": (fq, np.reshape(n_lp, shape), {"units": "1", "long_name": "linear programs of the polygon"}),
+            "angle_bound": (fq, np.reshape(bound, shape), {"units": "degree", "long_name":
+                            "certified bound on the error of the exact angle range (NaN: the image contains 0)"}),
+            "n_lp": (fq, np.reshape(n_lp, shape), {"units": "1", "long_name": "linear programs of the cut"}),
         },
         coords={"flank": ["left", "right"], "cut_position": q},
         attrs={"history": ds.attrs["history"], "member": int(ds.attrs["member"]), "n_contacts": int(c.n),

@@ -1,179 +1,33 @@
 """Figure 4, exactly: the set A ∩ C of the pile's final configuration (Moreau 2005, sections 4-5).
 
 The equilibrium forces of the final arrangement form the polytope
-``A ∩ C = {r : H r + F = 0, |r_t| <= mu r_n}`` (:class:`ncd.polytope.ForcePolytope`
-builds its scaled equations and Coulomb rows).  Every quantity of the figure is a
-linear map of ``r`` (cut resultants, ground forces), so its exact range over
-A ∩ C is given by linear programs.  :class:`ExactSet` keeps one sparse HiGHS
-model (``highspy``) whose only rows are the equilibrium equations (the Coulomb
-sectors are column bounds, :func:`cone_columns`) and changes only its objective
-between queries, so that each LP restarts (primal simplex) from the previous
-optimal basis:
+``A ∩ C = {r : H r + F = 0, |r_t| <= mu r_n}``.  Every quantity of the figure is a
+linear map of ``r`` (cut resultants, ground forces), so its exact range over A ∩ C
+is given by linear programs on one warm-started HiGHS model
+(:class:`ncd.exact_set.ExactSet`).  :func:`exact_dataset` writes ``exact.nc``:
 
-* :meth:`ExactSet.polygon`: the exact projection of A ∩ C under a 2-row map
-  (a cut resultant) -- ``n_dirs`` support directions evenly spread, then every
-  hull edge tested along its outer normal until inner and outer polygons agree;
-* :meth:`ExactSet.interval`: the exact min and max of one linear functional
-  (a ground-pressure value, a dip depth, the vertical component of a resultant).
-
-:func:`exact_dataset` applies them to the pile (``exact.nc``): the polygons of
-the default cut and of the cuts moved by ``± shift_d``, per cut of both flanks
-the exact range of the resultant's angle below the horizontal and of its
-vertical component (a state *arches* across a cut when the inner side pushes the
-bank downward, ``F_y < 0``: every admissible state arches iff ``max F_y < 0``),
-and the exact range of the ground pressure (:mod:`ncd.figures.pressure`).
+* (a) the exact polygon of the cut resultant (:meth:`ExactSet.polygon`) for the
+  default cut and the cuts moved by ``± shift_d``;
+* (b) for every cut of both flanks the exact range of the resultant's angle below the
+  horizontal (:meth:`ExactSet.angle_range`, a linear-fractional program: a few LPs,
+  certified, no polygon needed) and of its vertical component (a state *arches*
+  across a cut when the inner side pushes the bank downward, ``F_y < 0``: every
+  admissible state arches iff ``max F_y < 0``);
+* (c) the exact range of the ground pressure (:mod:`ncd.figures.pressure`) and the
+  dip verdict.
 """
 import time
 
-import highspy
 import numpy as np
-import scipy.sparse as sp
 import xarray as xr
 
 from ..contacts import h_matrix
+from ..exact_set import ExactSet
 from ..io import provenance
-from ..polygon import hull_area, outside_distance, polygon_area, support_polygon
-from ..polytope import ForcePolytope, PolytopeError
+from ..polygon import hull_area, outside_distance, polygon_area
 from . import cuts as cm
 
-FEAS_TOL = 1e-10
-
-
-class ExactSet:
-    """A ∩ C of ``H r + F = 0`` (r: 2 kappa forces) with Coulomb cones, as one HiGHS model."""
-
-    def __init__(self, H, F, mu):
-        self.fp = fp = ForcePolytope(H, F, mu)
-        self.scale, self.n = fp.scale, 2 * fp.n_contacts
-        self.T, upper = cone_columns(fp.mu)
-        self._Tt = self.T.T.tocsr()
-        A = (fp.A_eq @ self.T).tocsc()
-        lp = highspy.HighsLp()
-        lp.num_col_, lp.num_row_ = self.n, A.shape[0]
-        lp.col_cost_ = np.zeros(self.n)
-        lp.col_lower_ = np.zeros(self.n)
-        lp.col_upper_ = upper
-        lp.row_lower_ = fp.b_eq
-        lp.row_upper_ = fp.b_eq
-        lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
-        lp.a_matrix_.start_ = A.indptr
-        lp.a_matrix_.index_ = A.indices
-        lp.a_matrix_.value_ = A.data
-        h = highspy.Highs()
-        h.silent()
-        for k, v in (("primal_feasibility_tolerance", FEAS_TOL), ("dual_feasibility_tolerance", FEAS_TOL),
-                     ("threads", 1), ("random_seed", 0), ("simplex_strategy", 4)):
-            h.setOptionValue(k, v)
-        h.passModel(lp)
-        self.highs, self.n_lp, self.lp_time = h, 0, 0.0
-        self._cols = np.arange(self.n, dtype=np.int32)
-
-    def minimize(self, c):
-        """``(min c . r, r)`` over A ∩ C (``c`` in force units, ``r`` forces)."""
-        t0 = time.perf_counter()
-        self.highs.changeColsCost(self.n, self._cols, self._Tt @ np.asarray(c, dtype=float) * self.scale)
-        self.highs.run()
-        status = self.highs.getModelStatus()
-        self.n_lp += 1
-        self.lp_time += time.perf_counter() - t0
-        if status == highspy.HighsModelStatus.kInfeasible:
-            raise PolytopeError("A ∩ C is empty: no contact forces balance the weights")
-        if status != highspy.HighsModelStatus.kOptimal:
-            raise PolytopeError(f"LP not solved: {self.highs.modelStatusToString(status)}")
-        r = self.T @ np.maximum(np.asarray(self.highs.getSolution().col_value), 0.0) * self.scale
-        return float(np.dot(c, r)), r
-
-    def interval(self, c):
-        """Exact ``(min, max)`` of ``c . r`` over A ∩ C."""
-        lo = self.minimize(c)[0]
-        hi = -self.minimize(-np.asarray(c, dtype=float))[0]
-        return lo, hi
-
-    def refine(self, r, active_tol=1e-7):
-        """An LP vertex ``r`` (forces) made exact: the Coulomb rows it meets within
-        ``active_tol`` (scaled) and the equilibrium equations solved together by the
-        minimum-norm correction (iterated Tikhonov on ``[[I, K^T], [K, -eps I]]``, one
-        sparse LU), which removes the LP's feasibility-tolerance residue (HiGHS: ~1e-8
-        of the force scale)."""
-        x = np.asarray(r, float) / self.scale
-        G, A = self.fp.G, self.fp.A_eq
-        act = (G @ x) >= -active_tol
-        K = sp.vstack([A, G[np.nonzero(act)[0]]]).tocsr()
-        rhs = np.concatenate([self.fp.b_eq, np.zeros(int(act.sum()))])
-        return (x + _min_norm(K, rhs - K @ x)) * self.scale
-
-    def intervals(self, rows):
-        """Exact ``(min, max)`` of each row of a sparse matrix over A ∩ C, shape (m, 2).
-
-        All minima first, then all maxima, in row order: neighbouring rows (a
-        pressure profile) have neighbouring optima, so each LP restarts close by."""
-        rows = sp.csr_matrix(rows)
-        out = np.empty((rows.shape[0], 2))
-        for j, sign in ((0, 1.0), (1, -1.0)):
-            for i in range(rows.shape[0]):
-                out[i, j] = sign * self.minimize(sign * rows[i].toarray().ravel())[0]
-        return out
-
-    def polygon(self, L, n_dirs=180, tol=1e-9, max_lp=4000):
-        """Exact image of A ∩ C under the (2, 2 kappa) map ``L``: a convex polygon.
-
-        Support points in ``n_dirs`` evenly spread directions, then each edge of
-        their hull tested along its outer normal (a point beyond it by more than
-        ``tol`` times the force scale is added) until every edge is confirmed.
-        Returns ``vertices`` (ccw), ``inner_area``, ``outer_area`` (the polygon
-        of all supporting half-planes), ``n_lp``, ``exact`` and ``points`` (the
-        support points' full force vectors, one per LP).
-        """
-        L = sp.csr_matrix(L)
-        Lt = L.T.tocsr()
-        full = []
-
-        def query(u):
-            _, r = self.minimize(-(Lt @ u))
-            full.append(r)
-            return L @ r
-
-        dirs = [np.array([np.cos(a), np.sin(a)]) for a in 2 * np.pi * np.arange(n_dirs) / n_dirs]
-        out = support_polygon(query, dirs, tol * self.scale, max_lp, self.scale)
-        out["points"] = np.array(full)
-        return out
-
-
-def cone_columns(mu):
-    """The Coulomb sectors as bounds: ``r = T y`` with ``y >= 0`` (``y <= upper``).
-
-    Per contact ``y = (a, b) = (mu r_n + r_t, mu r_n - r_t)``, so that ``|r_t| <= mu r_n``
-    is ``a, b >= 0`` (``r_n = (a + b) / (2 mu)``, ``r_t = (a - b) / 2``); a frictionless
-    contact has ``r_n = a``, ``r_t = 0`` (``b`` fixed at 0).  The LP then has only the
-    equilibrium rows, and every LP point satisfies Coulomb's law to round-off."""
-    mu = np.asarray(mu, dtype=float)
-    k = len(mu)
-    i = np.arange(k)
-    rough = mu > 0
-    inv = np.where(rough, 0.5 / np.where(rough, mu, 1.0), 1.0)
-    rows = np.concatenate([2 * i, 2 * i, 2 * i + 1, 2 * i + 1])
-    cols = np.concatenate([2 * i, 2 * i + 1, 2 * i, 2 * i + 1])
-    vals = np.concatenate([inv, np.where(rough, inv, 0.0), np.where(rough, 0.5, 0.0), np.where(rough, -0.5, 0.0)])
-    T = sp.csr_matrix((vals, (rows, cols)), shape=(2 * k, 2 * k))
-    T.eliminate_zeros()
-    upper = np.full(2 * k, highspy.kHighsInf)
-    upper[2 * i[~rough] + 1] = 0.0
-    return T, upper
-
-
-def _min_norm(K, r, eps=1e-12, refine=20):
-    """Minimum-norm ``d`` with ``K d = r`` (K: p x n sparse, consistent)."""
-    from scipy.sparse.linalg import splu
-    p, n = K.shape
-    lu = splu(sp.bmat([[sp.identity(n), K.T], [K, -eps * sp.identity(p)]], format="csc"))
-    d = np.zeros(n)
-    for _ in range(refine):
-        e = r - K @ d
-        if np.abs(e).max(initial=0.0) <= 1e-16 * max(np.abs(r).max(initial=0.0), 1e-300):
-            break
-        d += lu.solve(np.concatenate([np.zeros(n), e]))[:n]
-    return d
-
+__all__ = ["ExactSet", "exact_dataset", "pile_problem", "resultant_angle"]
 
 def pile_problem(cfg, construction):
     """``(scene, contacts, H, F, mu)`` of the final configuration: ``H r + F = 0`` (forces)."""
@@ -221,12 +75,13 @@ def exact_dataset(cfg, construction, cuts, log=None):
     es = ExactSet(H, F, mu)
     C, _ = cm.cut_matrix(c, scene.pos, nm, _cut_specs(cuts))
     kind, outer = cuts["kind"].values, cuts["outer"].values
-    # (a) the polygons of the default and shifted cuts, (b) every cut's exact polygon
+    hist_F = (C @ history).reshape(-1, 2)
+    hist_angle = np.degrees(np.arctan2(-hist_F[:, 1], outer * hist_F[:, 0]))
+    # (a) the polygons of the default and shifted cuts
     polys, n_lp, exact, walls = [], [], [], []
-    for k in range(len(kind)):
-        n_dirs = ex["n_dirs"] if kind[k] != "scan" else ex["scan_dirs"]
+    for k in np.nonzero(kind != "scan")[0]:
         t1 = time.perf_counter()
-        p = es.polygon(C[2 * k: 2 * k + 2], n_dirs=n_dirs, tol=ex["tol"])
+        p = es.polygon(C[2 * k: 2 * k + 2], n_dirs=ex["n_dirs"], tol=ex["tol"])
         walls.append(time.perf_counter() - t1)
         polys.append(p["vertices"])
         n_lp.append(p["n_lp"])
@@ -236,14 +91,24 @@ def exact_dataset(cfg, construction, cuts, log=None):
             eq, co = es.fp.violations(refined)
             vertex_check = (float(eq.max()), float(co.max()))
             vertex_shift = float(np.abs(refined - p["points"][:len(refined)]).max() / es.scale)
-        if log is not None and kind[k] != "scan":
+        if log is not None:
             log.info("cut %d (%s): %d vertices, %d LPs, %.1f s", k, kind[k], len(p["vertices"]), p["n_lp"],
                      walls[-1])
-    angle = np.array([resultant_angle(v, o) for v, o in zip(polys, outer)])
-    fy_max = np.array([v[:, 1].max() for v in polys])
-    fy_min = np.array([v[:, 1].min() for v in polys])
-    hist_F = (C @ history).reshape(-1, 2)
-    hist_out = np.array([outside_distance(hist_F[k:k + 1], polys[k])[0] for k in range(len(kind))])
+    n_poly = len(polys)
+    # (b) every cut: the exact angle range (linear-fractional LPs) and vertical component
+    angle, bound, fy, angle_lp = np.empty((len(kind), 2)), np.empty(len(kind)), np.empty((len(kind), 2)), []
+    for k in range(len(kind)):
+        n0 = es.n_lp
+        rng = es.angle_range(C[2 * k: 2 * k + 2], outer[k], ref=hist_angle[k], tol=ex["angle_tol"])
+        angle[k], bound[k] = (rng["lo"], rng["hi"]), rng["bound"]
+        fy[k] = es.interval(C[2 * k + 1].toarray().ravel())
+        angle_lp.append(es.n_lp - n0)
+    fy_min, fy_max = fy[:, 0], fy[:, 1]
+    poly_angle = np.array([resultant_angle(v, o) for v, o in zip(polys, outer[:n_poly])]).reshape(-1, 2)
+    polygon_angle_gap = float(np.abs(poly_angle - angle[:n_poly]).max()) if n_poly else 0.0
+    hist_out = np.full(len(kind), np.nan)
+    hist_out[:n_poly] = [outside_distance(hist_F[k:k + 1], polys[k])[0] for k in range(n_poly)]
+    hist_angle_out = np.maximum(np.maximum(angle[:, 0] - hist_angle, hist_angle - angle[:, 1]), 0.0)
     # (c) ground pressure: the bins of cuts.nc and a kernel average on a grid
     edges = np.append(cuts["bin_lo"].values, cuts["bin_hi"].values[-1])
     B = pm.bin_matrix(c, nm, edges)
@@ -262,23 +127,35 @@ def exact_dataset(cfg, construction, cuts, log=None):
     if log is not None:
         log.info("%d LPs in %.1f s (%.1f s in HiGHS), total %.1f s", es.n_lp, es.lp_time, es.lp_time,
                  time.perf_counter() - t0)
+    n_cut = len(kind)
     width = max(len(v) for v in polys)
-    V = _pad(polys, width)
+    V = np.full((n_cut, width, 2), np.nan)
+    V[:n_poly] = _pad(polys, width)
+
+    def per_cut(values, fill):
+        out = np.full(n_cut, fill, dtype=np.asarray(values).dtype if len(values) else float)
+        out[:n_poly] = values
+        return out
+
     ds = xr.Dataset(
         {
             "vertex_fx": (("cut", "vertex"), V[..., 0], {"units": "N", "long_name": "exact polygon of the cut resultant: F_x of its vertices (NaN padding)"}),
             "vertex_fy": (("cut", "vertex"), V[..., 1], {"units": "N", "long_name": "exact polygon of the cut resultant: F_y of its vertices (NaN padding)"}),
-            "n_vertices": ("cut", np.array([len(v) for v in polys]), {"units": "1", "long_name": "vertices of the exact polygon"}),
-            "polygon_area": ("cut", np.array([max(polygon_area(v), 0.0) for v in polys]), {"units": "N2", "long_name": "area of the exact polygon"}),
-            "n_lp": ("cut", np.array(n_lp), {"units": "1", "long_name": "linear programs solved for the polygon"}),
-            "exact": ("cut", np.array(exact, np.int8), {"units": "1", "long_name": "polygon confirmed edge by edge (1) or LP budget exhausted (0)", "flag_values": np.array([0, 1], np.int8), "flag_meanings": "budget_exhausted confirmed"}),
+            "n_vertices": ("cut", per_cut(np.array([len(v) for v in polys]), 0), {"units": "1", "long_name": "vertices of the exact polygon (0: no polygon, scan cut)"}),
+            "polygon_area": ("cut", per_cut(np.array([max(polygon_area(v), 0.0) for v in polys]), np.nan), {"units": "N2", "long_name": "area of the exact polygon (NaN: no polygon)"}),
+            "n_lp": ("cut", per_cut(np.array(n_lp), 0), {"units": "1", "long_name": "linear programs solved for the polygon"}),
+            "angle_n_lp": ("cut", np.array(angle_lp), {"units": "1", "long_name": "linear programs solved for the angle range and the F_y range"}),
+            "angle_bound": ("cut", bound, {"units": "degree", "long_name": "certified bound on the error of the exact angle range (Dinkelbach's last LP value / min of the reference component)"}),
+            "exact": ("cut", per_cut(np.array(exact, np.int8), 2).astype(np.int8), {"units": "1", "long_name": "polygon confirmed edge by edge (1), LP budget exhausted (0), or no polygon computed (2: scan cut, angle range only)", "flag_values": np.array([0, 1, 2], np.int8), "flag_meanings": "budget_exhausted confirmed not_computed"}),
             "angle_min": ("cut", angle[:, 0], {"units": "degree", "long_name": "smallest angle below the horizontal (outward) of an admissible resultant"}),
             "angle_max": ("cut", angle[:, 1], {"units": "degree", "long_name": "largest angle below the horizontal (outward) of an admissible resultant"}),
             "fy_min": ("cut", fy_min, {"units": "N", "long_name": "smallest vertical component of an admissible resultant"}),
             "fy_max": ("cut", fy_max, {"units": "N", "long_name": "largest vertical component of an admissible resultant (< 0: every state arches)"}),
             "all_arch": ("cut", (fy_max < 0).astype(np.int8), {"units": "1", "long_name": "every admissible state pushes the bank downward across this cut", "flag_values": np.array([0, 1], np.int8), "flag_meanings": "not_every_state every_state"}),
-            "history_outside": ("cut", hist_out, {"units": "N", "long_name": "distance of the history resultant outside the exact polygon"}),
-            "polygon_wall_time": ("cut", np.array(walls), {"units": "s", "long_name": "measured wall time of the polygon's LPs (a measurement, not reproducible)"}),
+            "history_outside": ("cut", hist_out, {"units": "N", "long_name": "distance of the history resultant outside the exact polygon (NaN: no polygon)"}),
+            "history_angle": ("cut", hist_angle, {"units": "degree", "long_name": "angle below the horizontal (outward) of the history forces' resultant"}),
+            "history_angle_outside": ("cut", hist_angle_out, {"units": "degree", "long_name": "angle of the history resultant outside the exact angle range"}),
+            "polygon_wall_time": ("cut", per_cut(np.array(walls), np.nan), {"units": "s", "long_name": "measured wall time of the polygon's LPs (a measurement, not reproducible)"}),
             "bin_min": ("bin", band_bin[:, 0] , {"units": "N m-1", "long_name": "exact minimum of the binned ground pressure over A ∩ C"}),
             "bin_max": ("bin", band_bin[:, 1], {"units": "N m-1", "long_name": "exact maximum of the binned ground pressure over A ∩ C"}),
             "kernel_min": ("x_kernel", band_kernel[:, 0], {"units": "N m-1", "long_name": "exact minimum of the kernel ground pressure over A ∩ C"}),
@@ -296,7 +173,8 @@ def exact_dataset(cfg, construction, cuts, log=None):
                          vertex_refinement=vertex_shift,
                          dip_geometry=geometry, dip_called=called, dip_binning_spread=spread,
                          dip_main_choice=labels[main], dip_offset=ex["dip_offset_d"] * d,
-                         kernel_width=ex["kernel_d"] * d, n_lp_total=es.n_lp),
+                         kernel_width=ex["kernel_d"] * d, n_lp_total=es.n_lp,
+                         polygon_angle_gap=polygon_angle_gap),
     )
     ds["x_kernel"].attrs.update(units="m", long_name="abscissa of the kernel ground pressure")
     ds["vertex"].attrs.update(units="1", long_name="vertex index")
@@ -360,7 +238,10 @@ def exact_text(exact, ens, cuts):
                  f"{len(arch)} cuts; the exact angle of the resultant below the horizontal spans "
                  f"{np.nanmin(exact.angle_max.values - exact.angle_min.values):.1f}° to "
                  f"{np.nanmax(exact.angle_max.values - exact.angle_min.values):.1f}° (median "
-                 f"{np.nanmedian(exact.angle_max.values - exact.angle_min.values):.1f}°) across a cut.")
+                 f"{np.nanmedian(exact.angle_max.values - exact.angle_min.values):.1f}°) across a cut (each end a "
+                 f"linear-fractional program: {int(np.median(exact.angle_n_lp.values))} LPs per cut on median, "
+                 f"certified to {np.nanmax(exact.angle_bound.values):.0e}°; on the three polygons the ranges agree "
+                 f"with the polygons' own to {a['polygon_angle_gap']:.0e}°).")
     m = list(exact.choice.values).index(a["dip_main_choice"])
     lines.append(f"Ground pressure ({a['dip_main_choice']} kernel): dip depth p(0) - (p(-a)+p(a))/2 with "
                  f"a = {a['dip_offset'] * 1e3:.1f} mm is {float(exact.depth_history[m]):.1f} N/m for the history "

@@ -11,6 +11,6 @@ pile = xr.load_dataset(snakemake.input.pile)  # noqa: F821
 out = history_exact.exact_ranges(cfg, pile, log)
 out.attrs.update(provenance(cfg))
 write_dataset(out, snakemake.output[0])  # noqa: F821
-log.info("exact deviation ranges (deg): min %s, max %s; history outside the polygon by at most %.2g N",
+log.info("exact deviation ranges (deg): min %s, max %s; history angle outside the exact range by at most %.2g degree",
          out.exact_deviation_min.values.round(1).tolist(), out.exact_deviation_max.values.round(1).tolist(),
          float(out.history_outside.max()))
