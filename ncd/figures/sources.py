@@ -47,6 +47,17 @@ class _Source:
             top = float(np.max(pos[near, 1] + radius[near]))
             self.height = max(self.height, top + (self.cfg["drop_height_d"] + 0.5) * self.d)
 
+    def _near(self, pos, radius):
+        """The grains that can touch a grain inserted at or above ``height``: an excluded
+        grain lies more than two largest radii, the clearance and one diameter below it, so
+        :meth:`_try` decides as it would against every grain (the same insertions, bit for
+        bit), with O(n) work per attempt instead of per site."""
+        if len(radius) == 0:
+            return pos, radius
+        reach = max(float(radius.max()), self.rmax) * 2.0 + 0.05 * self.d + self.d
+        keep = pos[:, 1] > self.height - reach
+        return pos[keep], radius[keep]
+
     def _radius(self):
         return self.rng.uniform(self.rmin, self.rmax) if self.radii is None else self.radii[self.taken]
 
@@ -95,6 +106,7 @@ class PointSource(_Source):
     def draw(self, pos, radius, limit):
         """New grains at free sites (clearance ``0.05 d``): positions and radii."""
         new_p, new_r = [], []
+        pos, radius = self._near(pos, radius)
         for x in self.slots[self.rng.permutation(len(self.slots))]:
             for j in range(self.rows):
                 if len(new_r) >= limit:
@@ -126,6 +138,7 @@ class RainSource(_Source):
 
     def draw(self, pos, radius, limit):
         new_p, new_r = [], []
+        pos, radius = self._near(pos, radius)
         for x in self.rng.uniform(-self.half_width, self.half_width, self.sites):
             if len(new_r) >= limit:
                 break
