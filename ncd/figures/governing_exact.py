@@ -28,6 +28,7 @@ scaled as in :class:`ncd.polytope.ForcePolytope`):
 """
 import numpy as np
 
+from ..exact_set import cone_columns
 from ..polytope import ForcePolytope, PolytopeError
 
 try:
@@ -37,50 +38,53 @@ except ImportError:         # pragma: no cover - a dependency in pyproject.toml
 
 
 class _Model:
-    """One HiGHS model of the scaled ``A ∩ C``: rows ``A_eq x = b_eq`` and ``G x <= 0``."""
+    """One HiGHS model of the scaled ``A ∩ C`` with the Coulomb sectors as column bounds
+    (:func:`ncd.exact_set.cone_columns`: ``x = T y``, ``y >= 0``), so that its only rows are
+    the equilibrium equations ``A_eq x = b_eq``; queries take and return ``x`` (scaled
+    forces).  Only the objective changes between solves; :meth:`minimize` can restart
+    from a stored basis (``start``).  Measured on a 200-disc packing at mu = 0.01 (786
+    forces): the sectors as bounds instead of 3 kappa rows and the restart from the best
+    known point make the 4 kappa range LPs 2.5-3x faster than rows and last-basis restarts."""
 
     def __init__(self, P, feas_tol=1e-10):
-        import scipy.sparse as sp
         if highspy is None:
             raise ImportError("highspy is required for the exact measures of figure 5")
         self.P = P
         n = 2 * P.n_contacts
-        A = sp.vstack([P.A_eq, P.G]).tocsc()
-        m_eq = P.A_eq.shape[0]
-        inf = highspy.kHighsInf
+        self.T, upper = cone_columns(P.mu)
+        self._Tt = self.T.T.tocsr()
+        A = (P.A_eq @ self.T).tocsc()
         lp = highspy.HighsLp()
         lp.num_col_, lp.num_row_ = n, A.shape[0]
         lp.col_cost_ = np.zeros(n)
-        lp.col_lower_ = np.full(n, -inf)
-        lp.col_upper_ = np.full(n, inf)
-        lp.row_lower_ = np.concatenate([P.b_eq, np.full(P.G.shape[0], -inf)])
-        lp.row_upper_ = np.concatenate([P.b_eq, np.zeros(P.G.shape[0])])
+        lp.col_lower_ = np.zeros(n)
+        lp.col_upper_ = upper
+        lp.row_lower_ = P.b_eq
+        lp.row_upper_ = P.b_eq
         lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
         lp.a_matrix_.start_ = A.indptr
         lp.a_matrix_.index_ = A.indices
         lp.a_matrix_.value_ = A.data
         self.h = highspy.Highs()
         self.h.setOptionValue("output_flag", False)
-        self.h.setOptionValue("primal_feasibility_tolerance", feas_tol)
-        self.h.setOptionValue("dual_feasibility_tolerance", feas_tol)
-        self.h.setOptionValue("threads", 1)
-        self.h.setOptionValue("presolve", "off")      # keep the basis: each solve is warm-started
-        self.h.setOptionValue("solver", "simplex")
-        self.h.setOptionValue("simplex_strategy", 4)  # primal: the last basis stays feasible (measured 1.5x)
+        for key, v in (("primal_feasibility_tolerance", feas_tol), ("dual_feasibility_tolerance", feas_tol),
+                       ("threads", 1), ("random_seed", 0), ("presolve", "off"), ("solver", "simplex"),
+                       ("simplex_strategy", 4)):    # primal: a stored basis stays feasible
+            self.h.setOptionValue(key, v)
         self.h.passModel(lp)
-        self.n, self.m_eq = n, m_eq
-        self.cost = np.zeros(n)
+        self.n, self.m_eq = n, A.shape[0]
+        self._cols = np.arange(n, dtype=np.int32)
         self.n_lp = 0
 
-    def minimize(self, c):
-        """``argmin c . x`` (scaled), or None if infeasible.  When ``c . x`` is unbounded
-        below, returns ``(x + t d, False)`` style point via :meth:`ray_point` and marks
+    def minimize(self, c, start=None):
+        """``argmin c . x`` (scaled), or None if infeasible; restarted from the basis
+        ``start`` (:meth:`basis`) when given, else from the last one.  When ``c . x`` is
+        unbounded below, returns a point far along a ray (:meth:`ray_point`) and sets
         ``self.unbounded``; raises on any other failure."""
         c = np.asarray(c, float)
-        changed = np.nonzero(c != self.cost)[0]
-        if len(changed):
-            self.h.changeColsCost(len(changed), changed.astype(np.int32), c[changed])
-            self.cost = c.copy()
+        self.h.changeColsCost(self.n, self._cols, self._Tt @ c)
+        if start is not None:
+            self.h.setBasis(start)
         self.h.run()
         self.n_lp += 1
         status = self.h.getModelStatus()
@@ -91,14 +95,17 @@ class _Model:
             return self.ray_point(c)
         if status != highspy.HighsModelStatus.kOptimal:
             raise PolytopeError(f"LP failed: {self.h.modelStatusToString(status)}")
-        return np.array(self.h.getSolution().col_value)
+        return self.T @ np.maximum(np.asarray(self.h.getSolution().col_value), 0.0)
 
+    def basis(self):
+        """The current optimal basis (a copy), to restart a later solve from."""
+        return self.h.getBasis()
 
     def ray_point(self, c):
         """A point of ``A ∩ C`` far along an unbounded ray of decreasing ``c . x``
         (base point + unit ray): the set is unbounded along ``c``."""
         _, has_ray, ray = self.h.getPrimalRay()
-        ray = np.asarray(ray, float)
+        ray = self.T @ np.asarray(ray, float)
         if not has_ray or not (c @ ray < 0):
             raise PolytopeError("HiGHS reported an unbounded LP without a primal ray")
         return self.base + ray / np.abs(ray).max()
@@ -119,6 +126,9 @@ def force_ranges(P, model, zero_tol=1e-10):
     mu = P.mu
     jobs = [(a, comp, sign) for a in range(k) for comp, sign in ((0, -1.0), (1, 1.0), (1, -1.0))]
     jobs += [(a, 0, 1.0) for a in range(k)]
+    bases = []
+    best_value = np.array([np.full(2 * k, -np.inf), np.full(2 * k, np.inf)])   # largest, least x seen
+    best_at = np.full((2, 2 * k), -1)
     for a, comp, sign in jobs:
         j = 2 * a + comp
         if comp == 1 and mu[a] == 0.0:
@@ -127,10 +137,15 @@ def force_ranges(P, model, zero_tol=1e-10):
             continue                                   # min r_n = 0, attained at a known point
         c[:] = 0.0
         c[j] = sign
-        x = model.minimize(c)
+        best = int(best_at[int(sign > 0), j])          # restart from the best known point
+        x = model.minimize(c, bases[best] if 0 <= best != len(points) - 1 else None)
         if x is None:
             raise PolytopeError("A ∩ C is empty")
         points.append(x)
+        bases.append(model.basis() if not model.unbounded else None)
+        if not model.unbounded:
+            for row, better in ((0, x > best_value[0]), (1, x < best_value[1])):
+                best_value[row, better], best_at[row, better] = x[better], len(points) - 1
         if not model.unbounded:
             np.minimum(seen_min, x[0::2], out=seen_min)
         value = -sign * np.inf if model.unbounded else x[j]
