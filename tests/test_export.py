@@ -7,7 +7,7 @@ import pytest
 import xarray as xr
 
 from ncd.export import ExportError, animate, write_vtk
-from ncd.figures.slope import frames_dataset
+from ncd.figures.frames import frames_dataset
 
 
 def _frames(n_frames=3, n_discs=4):

@@ -41,7 +41,8 @@ ENSEMBLE_THREADS = 2
 NCD_CORE = sorted(str(REL / "ncd" / p.name) for p in (ROOT / "ncd").glob("*.py"))
 NCD_MODULES = {
     "fig1_wedged": ["figures/__init__.py", "figures/wedged.py"],
-    "fig2_slope": ["figures/__init__.py", "figures/slope.py", "figures/slope_analysis.py", "figures/census.py"],
+    "fig2_slope": ["figures/__init__.py", "figures/slope.py", "figures/slope_analysis.py", "figures/census.py",
+                   "figures/frames.py"],
     "fig3_equilibrium": ["figures/__init__.py", "figures/equilibrium.py", "figures/faces.py"],
     "fig4_pile": ["figures/__init__.py", "figures/pile.py", "figures/cuts.py", "figures/construction.py",
                   "figures/sources.py", "figures/pile_exact.py", "figures/pressure.py"],
@@ -52,7 +53,7 @@ NCD_MODULES = {
     "fig5_governing": ["figures/__init__.py", "figures/equilibrium.py", "figures/governing.py",
                        "figures/governing_exact.py", "figures/governing_plot.py", "figures/governing_flow.py",
                        "figures/governing_line.py", "figures/slope.py", "figures/slope_analysis.py",
-                       "figures/census.py", "figures/governing_summary.py"],
+                       "figures/census.py", "figures/governing_summary.py", "figures/frames.py"],
     "stability": ["studies/__init__.py", "studies/stability.py", "studies/scenes.py"],
     "error_vs_runtime": ["studies/__init__.py", "studies/work_precision.py", "studies/scenes.py"],
     "bench": ["studies/__init__.py", "studies/bench.py", "studies/peer.py", "studies/c_sweep.c",
