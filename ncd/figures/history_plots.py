@@ -53,8 +53,10 @@ def plot_dips(ax, an):
                     alpha=0.5)
             lo, hi = float(s.dip_lo.sel(kernel=k)), float(s.dip_hi.sel(kernel=k))
             m = float(s.dip_mean.sel(kernel=k))
-            ax.errorbar(x, m, yerr=[[m - lo], [hi - m]], fmt="o", color=COLORS[h], capsize=3,
-                        label=LABELS[h] if j == 0 else None)
+            # a bar from lo to hi, not an error bar: the dip of the mean profile (a min/max of
+            # a mean) can lie outside its percentile bootstrap band (biased upwards by noise)
+            ax.vlines(x, lo, hi, color=COLORS[h], lw=1.2)
+            ax.plot(x, m, "o", color=COLORS[h], label=LABELS[h] if j == 0 else None)
     for j, k in enumerate(ks):
         ax.text(j, 0.97, f"p = {float(an.dip_diff_p.sel(kernel=k)):.3g}", ha="center", va="top", fontsize=7,
                 transform=ax.get_xaxis_transform())
@@ -85,9 +87,8 @@ def plot_arching(ax, an):
             s = an.sel(history=h, flank=f)
             x = sign * q
             ax.fill_between(x, s.deviation_q25, s.deviation_q75, color=COLORS[h], alpha=0.15, lw=0)
-            ax.errorbar(x, s.deviation_median, yerr=[s.deviation_median - s.deviation_median_lo,
-                                                     s.deviation_median_hi - s.deviation_median],
-                        fmt="o-", ms=3, color=COLORS[h], capsize=2, label=LABELS[h] if f == "left" else None)
+            ax.vlines(x, s.deviation_median_lo, s.deviation_median_hi, color=COLORS[h], lw=1.0)
+            ax.plot(x, s.deviation_median, "o-", ms=3, color=COLORS[h], label=LABELS[h] if f == "left" else None)
     ax.axhline(0, color="0.6", lw=0.6)
     ax.set_xlabel("cut position x / L")
     ax.set_ylabel("resultant angle - flank slope (deg)")
