@@ -181,3 +181,38 @@ def test_finish_none_is_default():
     assert ncd.SolverSettings().finish == "none"
     with pytest.raises(ValueError, match="finish"):
         ncd.SolverSettings(finish="newton")
+
+
+def test_rest_polyhedron_is_the_equilibrium_set():
+    """finish.rest_status: every contact sticking (none has a positive gap velocity at rest).
+    Its polyhedron is A ∩ C times h: the projection of a non-admissible guess lands on
+    equilibrium forces inside the Coulomb cones (ForcePolytope.violations ~ round-off), with
+    the bodies at rest: an exact one-step solution (natural-map residual ~ round-off)."""
+    from ncd.contacts import h_matrix
+    from ncd.polytope import ForcePolytope
+    R, h3 = 1.0, np.sqrt(3.0)
+    ground = np.array([[-4.0, 0.0], [-2.0, 0.0], [0.0, 0.0], [2.0, 0.0], [4.0, 0.0]])
+    pos = np.array([[-1.0, h3], [1.0, h3], [0.0, 2 * h3], [-3.0, h3], [3.0, h3]])
+    scene = make_scene(pos, np.full(5, R), 1.0, obstacle_pos=ground, obstacle_radius=np.full(5, R),
+                       gravity=(0.0, -10.0), mu=0.4)
+    problem = _rest_problem(scene)
+    c = problem.contacts
+    W, Hm, minv = finish.global_delassus(scene, c)
+    free = np.column_stack([problem.free_vel[:5], problem.free_spin[:5]]).ravel()
+    mgh = float(scene.mass[0]) * 10.0 * H
+    lp = finish_lp.StatusLP.discs(Hm, minv, free, problem.bias, c.mu, scene.radius[:5], mgh, 10.0 * H)
+    status = finish.rest_status(lp)
+    assert (status == STICK).all()
+    guess = np.tile([[mgh, 0.3 * mgh]], (c.n, 1))              # tangential impulses beyond some cones
+    s, u, info = finish_lp.project(lp, guess, status)
+    assert s is not None
+    np.testing.assert_allclose(u, 0.0, atol=1e-12)
+    F = np.zeros((5, 3))
+    F[:, :2] = scene.mass[:5, None] * scene.gravity[None, :]
+    fp = ForcePolytope(h_matrix(scene, c), F.ravel(), c.mu)
+    eq, co = fp.violations((s / H).ravel()[None, :])
+    assert eq.max() <= 1e-12 and co.max() <= 1e-12
+    assert info["correction"] > 0.01 * mgh                      # the guess was not admissible
+    residual = finish.relative_residual(s, (W @ s.ravel() + (Hm.T @ free + problem.bias.ravel())).reshape(-1, 2),
+                                        c.mu, 1.0 / W.diagonal()[0::2], mgh)
+    assert residual <= 1e-12
