@@ -56,6 +56,22 @@ def test_frictionless_packing_is_determinate():
     np.testing.assert_allclose(m["force_min"][:, 1], 0.0, atol=1e-9 * m["scale"])
 
 
+def test_unger_relax_records_a_packing_it_cannot_start_from():
+    """When the first relaxation does not reach rest (here: a 1-sweep budget), the packing
+    is recorded unsampled (later rounds NaN, flags False) instead of failing the shard."""
+    p = dict(n_discs=14, radius_min=0.01, width_radii=14, density=1.0, gravity=9.81, root_seed=3, h=2e-4,
+             max_steps=20000, check_every=50, speed_tol=1.0, velocity_tol=1e-6,
+             solver=dict(tol=1e-3, max_sweeps=1000, check_every=10),
+             rest_solver=dict(tol=1e-8, max_sweeps=50000, check_every=10))
+    scene, _ = fg.build(p, "box", 0.5, member=1)
+    problem = rest_problem(scene, p["h"])
+    cfg = {"packings": p, "unger": dict(rounds=3, noise=0.5, solver=dict(tol=1e-12, max_sweeps=1, check_every=1))}
+    f, conv, rest = fg.unger_relax(scene, problem, cfg, np.random.default_rng(0))
+    assert f.shape == (4, problem.contacts.n, 2)
+    assert np.isfinite(f[0]).all() and np.isnan(f[1:]).all()
+    assert not conv.any() and not rest[1:].any()
+
+
 def test_wedged_disc_is_unbounded():
     """A disc held by friction between two walls facing each other (rows: F_x, F_y,
     torque; unit weight): r_t = ±1/2, r_n1 = r_n2 >= 1 / (2 mu), unbounded above."""

@@ -255,7 +255,8 @@ def unger_relax(scene, problem, cfg, rng, start=None):
     NLGS is finished by the active-set stage (``unger.solver.finish``), so that a
     relaxed point satisfies ``u_f = 0`` to round-off rather than to the tolerance.
     Returns ``(forces (rounds + 1, kappa, 2), converged, at_rest)``: a round counts
-    only when NLGS converged and ``u_f = 0`` (the relaxed forces lie in A ∩ C)."""
+    only when NLGS converged and ``u_f = 0`` (the relaxed forces lie in A ∩ C).  When
+    the first relaxation fails, the later rounds are not run (NaN forces, flags False)."""
     u, p = cfg["unger"], cfg["packings"]
     settings = SolverSettings(**u["solver"])
     h, g, nm = p["h"], p["gravity"], scene.n_mobile
@@ -276,8 +277,10 @@ def unger_relax(scene, problem, cfg, rng, start=None):
         rest.append(bool(ok_rest))
         if res.converged and ok_rest:
             s = res.impulse.copy()
-        elif s is None:
-            raise RuntimeError("the first relaxation of the packing did not converge to rest")
+        elif s is None:     # no starting solution: the packing is recorded, unsampled (eta NaN)
+            pad = u["rounds"]
+            return (np.concatenate([np.array(forces), np.full((pad, n, 2), np.nan)]),
+                    np.array(conv + [False] * pad), np.array(rest + [False] * pad))
     return np.array(forces), np.array(conv), np.array(rest)
 
 
