@@ -6,8 +6,9 @@ scaled as in :class:`ncd.polytope.ForcePolytope`):
 * ``rank H``, ``dim A = 2 kappa - rank H``;
 * the exact range ``[min, max]`` of every contact's normal and tangential force
   over ``A ∩ C``: 4 kappa linear programs solved by HiGHS (``highspy``), one
-  model whose objective alone changes, each solve warm-started from the last
-  basis (:func:`force_ranges`);
+  model (Coulomb sectors as column bounds) whose objective alone changes, each
+  solve restarted from the basis of the best point known for its objective
+  (:func:`force_ranges`);
 * the implicit equalities of ``A ∩ C`` (Coulomb rows tight at every point: a
   contact carrying no force, or forced to slide), found from the LP points and
   confirmed one by one by LP; the *rank count*
