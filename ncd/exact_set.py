@@ -19,7 +19,7 @@ import highspy
 import numpy as np
 import scipy.sparse as sp
 
-from .polygon import support_polygon
+from .polygon import outside_distance, support_polygon
 from .polytope import ForcePolytope, PolytopeError
 
 FEAS_TOL = 1e-10
@@ -33,24 +33,9 @@ class ExactSet:
         self.scale, self.n = fp.scale, 2 * fp.n_contacts
         self.T, upper = cone_columns(fp.mu)
         self._Tt = self.T.T.tocsr()
-        A = (fp.A_eq @ self.T).tocsc()
-        lp = highspy.HighsLp()
-        lp.num_col_, lp.num_row_ = self.n, A.shape[0]
-        lp.col_cost_ = np.zeros(self.n)
-        lp.col_lower_ = np.zeros(self.n)
-        lp.col_upper_ = upper
-        lp.row_lower_ = fp.b_eq
-        lp.row_upper_ = fp.b_eq
-        lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
-        lp.a_matrix_.start_ = A.indptr
-        lp.a_matrix_.index_ = A.indices
-        lp.a_matrix_.value_ = A.data
-        h = highspy.Highs()
-        h.silent()
-        for k, v in (("primal_feasibility_tolerance", FEAS_TOL), ("dual_feasibility_tolerance", FEAS_TOL),
-                     ("threads", 1), ("random_seed", 0), ("simplex_strategy", 4)):
-            h.setOptionValue(k, v)
-        h.passModel(lp)
+        h = sector_model(fp.A_eq, fp.b_eq, self.T, upper,
+                         primal_feasibility_tolerance=FEAS_TOL, dual_feasibility_tolerance=FEAS_TOL,
+                         threads=1, random_seed=0, simplex_strategy=4)
         self.highs, self.n_lp, self.lp_time = h, 0, 0.0
         self._cols = np.arange(self.n, dtype=np.int32)
 
@@ -156,7 +141,6 @@ class ExactSet:
         if not p_min > 1e-9 * self.scale:
             # the reference direction does not separate the image from the origin: the
             # exact polygon decides (its angle range, or NaN if it contains the origin)
-            from .polygon import outside_distance
             poly = self.polygon(L, n_dirs=12)
             v = (M @ np.asarray(poly["points"]).T).T
             if len(poly["vertices"]) < 3 or outside_distance(np.zeros((1, 2)), poly["vertices"])[0] > 0.0:
@@ -187,6 +171,30 @@ class ExactSet:
         out.update(lo=float(ends[0]), hi=float(ends[1]), bound=float(np.degrees(max(bounds))),
                    n_lp=self.n_lp - n0)
         return out
+
+
+def sector_model(A_eq, b_eq, T, upper, **options):
+    """A HiGHS model of ``A_eq T y = b_eq``, ``0 <= y <= upper`` (the Coulomb sectors as
+    column bounds, :func:`cone_columns`), zero cost, silent, with the given options."""
+    A = (A_eq @ T).tocsc()
+    n = A.shape[1]
+    lp = highspy.HighsLp()
+    lp.num_col_, lp.num_row_ = n, A.shape[0]
+    lp.col_cost_ = np.zeros(n)
+    lp.col_lower_ = np.zeros(n)
+    lp.col_upper_ = upper
+    lp.row_lower_ = b_eq
+    lp.row_upper_ = b_eq
+    lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
+    lp.a_matrix_.start_ = A.indptr
+    lp.a_matrix_.index_ = A.indices
+    lp.a_matrix_.value_ = A.data
+    h = highspy.Highs()
+    h.silent()
+    for k, v in options.items():
+        h.setOptionValue(k, v)
+    h.passModel(lp)
+    return h
 
 
 def cone_columns(mu):

@@ -40,12 +40,17 @@ def test_single_support_without_friction_is_determinate():
     assert m["implicit_sliding"][0]
 
 
+def small_box(check_every, tol, rest_tol):
+    """Packing parameters of a 14-disc box built by contact dynamics."""
+    return dict(n_discs=14, radius_min=0.01, width_radii=14, density=1.0, gravity=9.81, root_seed=3, h=2e-4,
+                max_steps=20000, check_every=check_every, speed_tol=1.0, velocity_tol=1e-6,
+                solver=dict(tol=tol, max_sweeps=1000, check_every=10),
+                rest_solver=dict(tol=rest_tol, max_sweeps=50000, check_every=10))
+
+
 def test_frictionless_packing_is_determinate():
     """A packing built by contact dynamics at mu = 0: every contact force fixed, eta = 0."""
-    p = dict(n_discs=14, radius_min=0.01, width_radii=14, density=1.0, gravity=9.81, root_seed=3, h=2e-4,
-             max_steps=20000, check_every=100, speed_tol=1.0, velocity_tol=1e-6,
-             solver=dict(tol=1e-4, max_sweeps=1000, check_every=10),
-             rest_solver=dict(tol=1e-9, max_sweeps=50000, check_every=10))
+    p = small_box(check_every=100, tol=1e-4, rest_tol=1e-9)
     scene, info = fg.build(p, "box", 0.0, member=0)
     problem = rest_problem(scene, p["h"])
     m = ge.exact_measures(h_matrix(scene, problem.contacts), external_force(scene), problem.contacts.mu)
@@ -59,10 +64,7 @@ def test_frictionless_packing_is_determinate():
 def test_unger_relax_records_a_packing_it_cannot_start_from():
     """When the first relaxation does not reach rest (here: a 1-sweep budget), the packing
     is recorded unsampled (later rounds NaN, flags False) instead of failing the shard."""
-    p = dict(n_discs=14, radius_min=0.01, width_radii=14, density=1.0, gravity=9.81, root_seed=3, h=2e-4,
-             max_steps=20000, check_every=50, speed_tol=1.0, velocity_tol=1e-6,
-             solver=dict(tol=1e-3, max_sweeps=1000, check_every=10),
-             rest_solver=dict(tol=1e-8, max_sweeps=50000, check_every=10))
+    p = small_box(check_every=50, tol=1e-3, rest_tol=1e-8)
     scene, _ = fg.build(p, "box", 0.5, member=1)
     problem = rest_problem(scene, p["h"])
     cfg = {"packings": p, "unger": dict(rounds=3, noise=0.5, solver=dict(tol=1e-12, max_sweeps=1, check_every=1))}

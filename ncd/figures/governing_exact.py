@@ -27,15 +27,11 @@ scaled as in :class:`ncd.polytope.ForcePolytope`):
   mean over contacts of the diagonal of the bounding box of the contact's
   projection over the mean force at the box centres.
 """
+import highspy
 import numpy as np
 
-from ..exact_set import cone_columns
+from ..exact_set import cone_columns, sector_model
 from ..polytope import ForcePolytope, PolytopeError
-
-try:
-    import highspy
-except ImportError:         # pragma: no cover - a dependency in pyproject.toml
-    highspy = None
 
 
 class _Model:
@@ -48,32 +44,14 @@ class _Model:
     known point make the 4 kappa range LPs 2.5-3x faster than rows and last-basis restarts."""
 
     def __init__(self, P, feas_tol=1e-10):
-        if highspy is None:
-            raise ImportError("highspy is required for the exact measures of figure 5")
         self.P = P
         n = 2 * P.n_contacts
         self.T, upper = cone_columns(P.mu)
         self._Tt = self.T.T.tocsr()
-        A = (P.A_eq @ self.T).tocsc()
-        lp = highspy.HighsLp()
-        lp.num_col_, lp.num_row_ = n, A.shape[0]
-        lp.col_cost_ = np.zeros(n)
-        lp.col_lower_ = np.zeros(n)
-        lp.col_upper_ = upper
-        lp.row_lower_ = P.b_eq
-        lp.row_upper_ = P.b_eq
-        lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
-        lp.a_matrix_.start_ = A.indptr
-        lp.a_matrix_.index_ = A.indices
-        lp.a_matrix_.value_ = A.data
-        self.h = highspy.Highs()
-        self.h.setOptionValue("output_flag", False)
-        for key, v in (("primal_feasibility_tolerance", feas_tol), ("dual_feasibility_tolerance", feas_tol),
-                       ("threads", 1), ("random_seed", 0), ("presolve", "off"), ("solver", "simplex"),
-                       ("simplex_strategy", 4)):    # primal: a stored basis stays feasible
-            self.h.setOptionValue(key, v)
-        self.h.passModel(lp)
-        self.n, self.m_eq = n, A.shape[0]
+        self.h = sector_model(P.A_eq, P.b_eq, self.T, upper, primal_feasibility_tolerance=feas_tol,
+                              dual_feasibility_tolerance=feas_tol, threads=1, random_seed=0, presolve="off",
+                              solver="simplex", simplex_strategy=4)    # primal: a stored basis stays feasible
+        self.n, self.m_eq = n, P.A_eq.shape[0]
         self._cols = np.arange(n, dtype=np.int32)
         self.n_lp = 0
 
