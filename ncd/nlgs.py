@@ -35,6 +35,7 @@ from .nlgs_pack import (C_BN, C_BT, C_MU, C_WNN, C_WTT, N_COEF, _add_impulse, _a
 
 CRITERIA = {"residual": 0, "change": 1}
 FINISHES = ("none", "active_set")
+ACCELS = ("none", "anderson")    # the iteration itself: plain NLGS or Anderson-accelerated (ncd.anderson)
 
 
 @dataclass(frozen=True)
@@ -47,6 +48,9 @@ class SolverSettings:
     ``observable_tol``: largest relative change of an observed quantity over the
     last residual checks for a run to count as converged (:mod:`ncd.convergence`).
     ``keep_best``: at ``max_sweeps`` return the iterate of smallest residual seen.
+    ``accel``: "none" (plain NLGS) or "anderson" (:mod:`ncd.anderson`: Anderson
+    acceleration of the sweeps with ``accel_memory`` stored differences, disc form only;
+    memory 0 is plain NLGS).
     """
     tol: float = 1e-8
     max_sweeps: int = 20000
@@ -56,6 +60,8 @@ class SolverSettings:
     finish_tol: float = 1e-10
     observable_tol: float = 1e-6
     keep_best: bool = True
+    accel: str = "none"           # "none" or "anderson"
+    accel_memory: int = 20
 
     def __post_init__(self):
         checks.solver_settings(self)    # InputError naming the field (issue 14)
@@ -70,6 +76,9 @@ class SolverSettings:
         for name in ("finish_tol", "observable_tol"):
             if not (np.isfinite(getattr(self, name)) and getattr(self, name) > 0):
                 raise ValueError(f"{name} = {getattr(self, name)!r} must be > 0")
+        if not isinstance(self.accel, str) or self.accel not in ACCELS:
+            raise checks.InputError(f"settings.accel = {self.accel!r} must be one of {ACCELS}")
+        object.__setattr__(self, "accel_memory", checks.integer("settings.accel_memory", self.accel_memory, 0, 1000))
 
     def as_attrs(self):
         return {f"solver_{k}": int(v) if isinstance(v, bool) else v for k, v in asdict(self).items()}
@@ -249,10 +258,14 @@ def solve_discs(scene, contacts, vel, spin, guess=None, review_order=None,
     pair, coef, body = pack_problem(c.body_a, c.body_b, c.normal, c.arm_a, c.arm_b, W, c.mu, bias,
                                     scene.inv_mass, scene.inv_inertia, vel, spin)
     flat = (pair.ravel(), coef.ravel(), body.ravel(), impulse.ravel())
+    iterate = _iterate_discs
+    if settings.accel == "anderson" and settings.accel_memory > 0:
+        from .anderson import driver
+        iterate = driver(flat, settings.accel_memory)      # before the guess: it keeps the free velocities
     _apply_all(*flat)
     from .convergence import run_nlgs
     look = None if observe is None else (lambda: observe(impulse, body[:-1, :2], body[:-1, 2]))
-    result = run_nlgs(_iterate_discs, flat, order, status, _scale(q_free, W), settings, look)
+    result = run_nlgs(iterate, flat, order, status, _scale(q_free, W), settings, look)
     result.impulse = impulse
     if settings.finish != "none":
         from .finish import polish_discs
@@ -331,6 +344,9 @@ def solve_local(W, q, mu, guess=None, review_order=None, settings=SolverSettings
     ``q`` (2n,); ``mu`` scalar or (n,).  Checks: :func:`ncd.checks.local_problem`.
     """
     W, q, mu, guess, review_order = checks.local_problem(W, q, mu, guess, review_order, settings)
+    if settings.accel != "none":
+        raise checks.InputError(f"settings.accel = {settings.accel!r}: acceleration is implemented "
+                                "for the disc form (solve_discs, solve_problem) only")
     if len(q) == 0:
         return NLGSResult(np.zeros((0, 2)), np.zeros(0, np.int8), 0, 0.0, 0.0, True)
     Wc = sp.csr_matrix(W, dtype=float)
