@@ -16,7 +16,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 WORKFLOW_FILES = ("Snakefile", "config.yaml", "profiles", "workflow", "notebooks", "ncd",
-                  "tests/config_reduced.yaml")
+                  "tests/config_reduced.yaml", "tests/config_reduced_size.yaml")
 
 
 def copy_workflow(dst):
@@ -48,10 +48,10 @@ def run_snakemake(repo, *args, extra_configs=(), check=True, workdir=None):
 
 @pytest.fixture(scope="session")
 def dag_repo(tmp_path_factory):
-    """A copy of the workflow in which the reduced DAG (every figure and the benchmark
-    suite) has run completely."""
+    """A copy of the workflow in which the reduced DAG (every figure, the benchmark
+    suite and fig4_history's size study) has run completely."""
     repo = copy_workflow(tmp_path_factory.mktemp("repo"))
-    run_snakemake(repo, "-j2", "all", "bench")
+    run_snakemake(repo, "-j2", "all", "bench", "fig4_history_size")
     return repo
 
 

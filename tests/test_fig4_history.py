@@ -199,17 +199,22 @@ def test_permutation_detects_a_difference_and_not_a_null():
 
 
 # ------------------------------------------------------------------ figure data
+def _sizes(results):
+    """Grain counts with an analysis, ascending (the smallest is the figure's; the size study adds others)."""
+    paths = glob.glob(str(results / "fig4_history" / "analysis_n*.nc"))
+    return sorted(int(p.rsplit("_n", 1)[1][:-3]) for p in paths)
+
+
 @pytest.fixture(scope="module")
 def piles(results):
-    paths = sorted(glob.glob(str(results / "fig4_history" / "piles" / "n*" / "*.nc")))
+    paths = sorted(glob.glob(str(results / "fig4_history" / "piles" / f"n{_sizes(results)[0]}" / "*.nc")))
     assert paths, "no pile files"
     return [xr.load_dataset(p) for p in paths]
 
 
 @pytest.fixture(scope="module")
 def analysis(results):
-    (path,) = glob.glob(str(results / "fig4_history" / "analysis_n*.nc"))
-    return xr.load_dataset(path)
+    return xr.load_dataset(results / "fig4_history" / f"analysis_n{_sizes(results)[0]}.nc")
 
 
 def test_every_pile_at_rest_and_carried_by_the_ground(piles):
@@ -274,3 +279,44 @@ def test_bands_are_over_piles(analysis, piles, results):
     assert float((analysis.profile_hi - analysis.profile_lo).max()) > 0.01
     assert np.all(analysis.profile_lo <= analysis.profile_mean + 1e-12)
     np.testing.assert_allclose(analysis.ground_fy / analysis.weight, 1.0, atol=WEIGHT_TOL)
+
+
+# ------------------------------------------------------------------ size study
+@pytest.fixture(scope="module")
+def size(results):
+    return xr.load_dataset(results / "fig4_history" / "size.nc")
+
+
+def test_size_study_compares_every_size(size, results):
+    """size.nc holds every analysed size in ascending order, and copies each analysis's dip bands."""
+    sizes = _sizes(results)
+    assert len(sizes) >= 2
+    assert size.sizes["size"] == len(sizes)
+    assert np.all(np.diff(size.grains.values) > 0)
+    for z, n in enumerate(sizes):
+        an = xr.load_dataset(results / "fig4_history" / f"analysis_n{n}.nc")
+        assert abs(size.grains.values[z] - an.n_grains.mean()) <= 0.5
+        assert size.piles.values[z] == an.sizes["pile"]
+        np.testing.assert_array_equal(size.dip_mean.values[z], an.dip_mean.values)
+        arch = np.nanmedian(an.cut_deviation.values.reshape(an.sizes["history"], an.sizes["pile"], -1), axis=2)
+        np.testing.assert_allclose(size.arching_pile.values[z, :, :an.sizes["pile"]], arch, rtol=0, atol=1e-12)
+        assert np.all(size.arching_lo.values[z] <= size.arching_mean.values[z] + 1e-12)
+        assert np.all(size.arching_mean.values[z] <= size.arching_hi.values[z] + 1e-12)
+    p = size.arching_size_p.values
+    assert np.isnan(p[0]).all() and np.all((p[1:] > 0) & (p[1:] <= 1))
+
+
+def test_size_comparison_sees_a_shift_and_not_a_null(analysis):
+    """Two copies of one analysis: no change (p = 1); a copy with every cut deviation 5° larger
+    and ten times the grains: an arching change of exactly 5° and an unchanged dip."""
+    from ncd.figures import history_size as hsz
+
+    same = hsz.size_dataset([analysis, analysis.assign(n_grains=analysis.n_grains * 10)])
+    assert np.all(same.arching_size_diff.values[1] == 0) and np.all(same.arching_size_p.values[1] == 1)
+    assert np.all(same.dip_size_p.values[1] == 1)
+    big = analysis.assign(n_grains=analysis.n_grains * 10, cut_deviation=analysis.cut_deviation + 5.0)
+    shifted = hsz.size_dataset([big, analysis])       # any order: sorted by grains
+    np.testing.assert_allclose(shifted.arching_size_diff.values[1], 5.0, atol=1e-9)
+    np.testing.assert_allclose(shifted.dip_size_diff.values[1], 0.0, atol=0)
+    with pytest.raises(ValueError, match="at least 2"):
+        hsz.size_dataset([analysis])

@@ -8,22 +8,71 @@
 #                                                                -> exact/n<n>/<history>_<m>.nc
 #   analyse    ground stress, dip, arching over the piles       -> analysis_n<n>.nc
 #   notebook   notebooks/fig4_history.ipynb                     -> results/figures/fig4_history.png|pdf
+# Size study (target fig4_history_size, not in the default run): the piles of this config and
+# of every overlay in fig4_history.size.overlays (a config file whose fig4_history section is
+# merged over this one, e.g. config/large.yaml: 10^4 grains), each analysed as above
+#   size       the analyses side by side                        -> size.nc
+#   notebook   notebooks/fig4_history_size.ipynb                -> results/figures/fig4_history_size.png|pdf
+import copy as _copy
+
+import yaml as _yaml
+from snakemake.utils import update_config as _update_config
+
 FIGH = "fig4_history"
 CFGH = section(FIGH)
 FH = f"results/{FIGH}"
 NH = CFGH["grains"]["n"]
 # the construction sees only what builds a pile (an analysis parameter does not rebuild the piles)
-CFGH_SIM = {k: CFGH[k] for k in ("root_seed", "grains", "ground", "mu", "mu_ground", "gravity", "h", "source",
-                                 "rain", "construction", "surface")}
+SIM_KEYS = ("root_seed", "grains", "ground", "mu", "mu_ground", "gravity", "h", "source", "rain", "construction",
+            "surface")
+
+
+def _size_sections():
+    """{n: fig4_history section} for this config and each size overlay, checked like the config."""
+    out = {NH: CFGH}
+    for path in CFGH.get("size", {}).get("overlays", []):
+        with open(REL / path) as f:
+            over = (_yaml.safe_load(f) or {}).get(FIGH)
+        if not isinstance(over, dict):
+            raise ValueError(f"fig4_history.size.overlays: {path} has no fig4_history section")
+        sec = _copy.deepcopy(CFGH)
+        _update_config(sec, over)
+        check_config({FIGH: sec}, [FIGH], ROOT / "workflow" / "schemas")
+        out.setdefault(int(sec["grains"]["n"]), sec)
+    return out
+
+
+SIZE_CFG = _size_sections()
+SIZES = sorted(SIZE_CFG)
+
+
+def size_cfg(n):
+    """The fig4_history section that builds piles of ``n`` grains."""
+    if int(n) not in SIZE_CFG:
+        raise ValueError(f"no fig4_history config builds piles of n = {n} grains (sizes: {SIZES})")
+    return SIZE_CFG[int(n)]
+
+
+def piles_of(n):
+    c = size_cfg(n)
+    return [f"{FH}/piles/n{n}/{h}_{m:03d}.nc" for h in ("point", "rain") for m in range(c["piles"])]
+
+
+def exact_of(n):
+    c = size_cfg(n)
+    return [f"{FH}/exact/n{n}/{h}_{m:03d}.nc" for h in ("point", "rain")
+            for m in range(min(c["exact"]["piles"], c["piles"]))]
+
+
 # the construction does not depend on the analysis, exact and plotting modules (editing them reruns
 # the analysis only)
-FH_AFTER = ("history_analysis.py", "history_exact.py", "history_plots.py", "pile_exact.py", "pressure.py")
+FH_AFTER = ("history_analysis.py", "history_exact.py", "history_plots.py", "history_size.py", "pile_exact.py",
+            "pressure.py")
 FH_BUILD_SOURCES = [f for f in ncd_sources(FIGH) if not f.endswith(FH_AFTER)]
-FH_PILES = [f"{FH}/piles/n{NH}/{h}_{m:03d}.nc" for h in ("point", "rain") for m in range(CFGH["piles"])]
-FH_EXACT = [f"{FH}/exact/n{NH}/{h}_{m:03d}.nc" for h in ("point", "rain")
-            for m in range(min(CFGH["exact"]["piles"], CFGH["piles"]))]
+FH_PILES = piles_of(NH)
+FH_EXACT = exact_of(NH)
 # the exact ranges (pile_exact: A ∩ C by HiGHS, through history_exact) do not depend on the plots
-FH_EXACT_SOURCES = [f for f in ncd_sources(FIGH) if not f.endswith("history_plots.py")]
+FH_EXACT_SOURCES = [f for f in ncd_sources(FIGH) if not f.endswith(("history_plots.py", "history_size.py"))]
 
 
 rule fig4_history_construct:
@@ -37,7 +86,7 @@ rule fig4_history_construct:
         member=r"\d+",
         n=r"\d+",
     params:
-        config=CFGH_SIM,
+        config=lambda w: {k: size_cfg(w.n)[k] for k in SIM_KEYS},
         checkpoint=lambda w: f"{FH}/checkpoints/n{w.n}/{w.history}_{w.member}.npz",
     log:
         log(FIGH, "construct_n{n}_{history}_{member}"),
@@ -60,7 +109,7 @@ rule fig4_history_exact:
         member=r"\d+",
         n=r"\d+",
     params:
-        config={k: v for k, v in CFGH.items() if k != "piles"},   # one pile's ranges: not the pile count
+        config=lambda w: {k: v for k, v in size_cfg(w.n).items() if k not in ("piles", "size")},   # one pile's ranges
     log:
         log(FIGH, "exact_n{n}_{history}_{member}"),
     benchmark:
@@ -74,16 +123,18 @@ rule fig4_history_exact:
 rule fig4_history_analyse:
     input:
         ncd_sources(FIGH),
-        piles=FH_PILES,
-        exact=FH_EXACT,
+        piles=lambda w: piles_of(w.n),
+        exact=lambda w: exact_of(w.n),
     output:
-        f"{FH}/analysis_n{NH}.nc",
+        f"{FH}/analysis_n{{n}}.nc",
+    wildcard_constraints:
+        n=r"\d+",
     params:
-        config=CFGH,
+        config=lambda w: {k: v for k, v in size_cfg(w.n).items() if k != "size"},
     log:
-        log(FIGH, f"analyse_n{NH}"),
+        log(FIGH, "analyse_n{n}"),
     benchmark:
-        bench(FIGH, f"analyse_n{NH}")
+        bench(FIGH, "analyse_n{n}")
     conda:
         CONDA_ENV
     script:
@@ -116,3 +167,53 @@ rule fig4_history_notebook:
 rule fig4_history:
     input:
         figure_targets(FIGH),
+
+
+FHS = "fig4_history_size"
+
+
+rule fig4_history_size_analyse:
+    """The analyses of every pile size side by side (ncd.figures.history_size)."""
+    input:
+        ncd_sources(FIGH),
+        analyses=[f"{FH}/analysis_n{n}.nc" for n in SIZES],
+    output:
+        f"{FH}/size.nc",
+    params:
+        seed=CFGH["analysis"]["seed"],
+    log:
+        log(FIGH, "size"),
+    benchmark:
+        bench(FIGH, "size")
+    conda:
+        CONDA_ENV
+    script:
+        "../scripts/fig4_history_size.py"
+
+
+rule fig4_history_size_notebook:
+    input:
+        sizes=f"{FH}/size.nc",
+        plots=str(REL / "ncd" / "figures" / "history_size.py"),
+        notebook=notebook_file(FHS),
+        notebook_py=notebook_file(FHS, "py"),
+    output:
+        png=figure_output(FHS, "png"),
+        pdf=figure_output(FHS, "pdf"),
+    params:
+        config={k: v for k, v in CFGH.items() if k == "size"},
+    log:
+        notebook=f"results/notebooks/{FHS}.ipynb",
+    benchmark:
+        bench(FHS, "notebook")
+    conda:
+        CONDA_ENV
+    notebook:
+        "../../notebooks/fig4_history_size.ipynb"
+
+
+rule fig4_history_size:
+    """The size study: piles of every size, their analyses and the comparison page (about an
+    hour of CPU with config/large.yaml's four piles of 10^4 grains per history)."""
+    input:
+        figure_targets(FHS),

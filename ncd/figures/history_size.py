@@ -1,0 +1,192 @@
+"""How the piles of fig4_history change with size (issue 16, item 4).
+
+The analyses of several pile sizes (``analysis_n<n>.nc`` of :mod:`.history_analysis`,
+one per grain count) side by side, per history:
+
+* the dip depth of the mean ground-stress profile with its bootstrap band over piles
+  (copied from each analysis), and its change from the smallest size with a permutation
+  p-value (size labels shuffled among the piles of both sizes, the dip of each mean
+  profile recomputed: :func:`.history_analysis.permutation_p`);
+* the arching: per pile, the median over both flanks and every cut position of the cut
+  deviation (resultant angle minus the pile's flank slope); its mean over piles with a
+  bootstrap band, and its change from the smallest size with a permutation p-value;
+* the median deviation per cut position (copied), the flank slope, the apex height over
+  the base half-width and the cone ratio (means over piles).
+
+The abscissae ``x / L`` and cut positions ``|x| / L`` are the same at every size, so the
+profiles compare directly.  Every band resamples piles, never runs of one pile.
+"""
+import numpy as np
+import xarray as xr
+
+from .history_analysis import bootstrap_index, permutation_p
+
+
+def _pile_arching(an):
+    """(history, pile): median over flanks and cut positions of the cut deviation (degree)."""
+    dev = an.cut_deviation.values
+    return np.nanmedian(dev.reshape(dev.shape[0], dev.shape[1], -1), axis=2)
+
+
+def _perm_mean(a, b, rng, n_perm):
+    """Two-sided permutation p-value of ``mean(b) - mean(a)`` (labels shuffled)."""
+    both = np.concatenate([a, b])
+    obs = abs(b.mean() - a.mean())
+    count = 0
+    for _ in range(n_perm):
+        idx = rng.permutation(len(both))
+        count += abs(both[idx[len(a):]].mean() - both[idx[:len(a)]].mean()) >= obs - 1e-12
+    return (count + 1) / (n_perm + 1)
+
+
+def size_dataset(analyses, seed=16):
+    """size.nc from ``analyses`` (analysis datasets of distinct grain counts, any order).
+    Every analysis must share the histories, kernels, abscissae and cut positions."""
+    if len(analyses) < 2:
+        raise ValueError(f"a size comparison needs at least 2 analyses, got {len(analyses)}")
+    grains = [int(round(float(an.n_grains.mean()))) for an in analyses]
+    order = np.argsort(grains)
+    ans = [analyses[i] for i in order]
+    ref = ans[0]
+    for an in ans[1:]:
+        for c in ("history", "kernel", "xi", "cut_position", "flank"):
+            if not np.array_equal(an[c].values, ref[c].values):
+                raise ValueError(f"analyses differ in coordinate {c!r}: {an[c].values} vs {ref[c].values}")
+    hist, K = list(ref.history.values), ref.kernel.values
+    S, H = len(ans), len(hist)
+    a = ref.attrs
+    lo_q, hi_q = 0.5 * (1 - a["level"]), 0.5 * (1 + a["level"])
+    rng = np.random.default_rng([seed, 4])
+    n_max = max(an.sizes["pile"] for an in ans)
+    arch = np.full((S, H, n_max), np.nan)
+    arch_mean, arch_lo, arch_hi = (np.full((S, H), np.nan) for _ in range(3))
+    arch_p, dip_p = np.full((S, H), np.nan), np.full((S, H, len(K)), np.nan)
+    for s, an in enumerate(ans):
+        per = _pile_arching(an)
+        n = per.shape[1]
+        arch[s, :, :n] = per
+        idx = bootstrap_index(rng, n, int(a["bootstrap"]))
+        boot = per[:, idx].mean(axis=2)                       # (history, B)
+        arch_mean[s] = per.mean(axis=1)
+        arch_lo[s], arch_hi[s] = np.quantile(boot, lo_q, axis=1), np.quantile(boot, hi_q, axis=1)
+        if s == 0:
+            continue
+        for i in range(H):
+            arch_p[s, i] = _perm_mean(arch[0, i, :ref.sizes["pile"]], per[i], rng, int(a["permutations"]))
+            for j, k in enumerate(K):
+                pa = ref.profile.values[i, :, j]
+                pb = an.profile.values[i, :, j]
+                dip_p[s, i, j] = permutation_p(float(ref.dip_mean.values[i, j]), float(an.dip_mean.values[i, j]),
+                                               pa, pb, ref.xi.values, a["dip_center"], np.asarray(a["dip_flank"]),
+                                               rng, int(a["permutations"]))
+    stack = lambda v: np.array([an[v].values for an in ans])            # noqa: E731
+    mean_over = lambda v: np.array([an[v].mean("pile").values for an in ans])   # noqa: E731
+    d = ref.attrs["mean_diameter"]
+    one = lambda dims, v, u, ln: (dims, v, {"units": u, "long_name": ln})  # noqa: E731
+    Z, Hd, P, Kd, F, Q = "size", "history", "pile", "kernel", "flank", "cut_position"
+    dip_mean = stack("dip_mean")
+    out = xr.Dataset(
+        {
+            "grains": one(Z, np.array(grains)[order], "1", "grains per pile (mean over piles, rounded)"),
+            "piles": one(Z, np.array([an.sizes["pile"] for an in ans]), "1", "piles per history"),
+            "n_grains_mean": one((Z, Hd), mean_over("n_grains"), "1", "grains in the final pile, mean over piles"),
+            "dip_mean": one((Z, Hd, Kd), dip_mean, "1", "dip depth of the mean profile (M - m) / M"),
+            "dip_lo": one((Z, Hd, Kd), stack("dip_lo"), "1", "bootstrap band over piles of dip_mean, lower"),
+            "dip_hi": one((Z, Hd, Kd), stack("dip_hi"), "1", "bootstrap band over piles of dip_mean, upper"),
+            "dip_size_diff": one((Z, Hd, Kd), dip_mean - dip_mean[:1], "1",
+                                 "dip_mean minus that of the smallest size"),
+            "dip_size_p": one((Z, Hd, Kd), dip_p, "1", "two-sided permutation p-value of dip_size_diff "
+                                                       "(size labels over piles; NaN: smallest size)"),
+            "arching_pile": one((Z, Hd, P), arch, "degree", "median over flanks and cut positions of one "
+                                                            "pile's cut deviation (NaN: padding)"),
+            "arching_mean": one((Z, Hd), arch_mean, "degree", "mean over piles of arching_pile"),
+            "arching_lo": one((Z, Hd), arch_lo, "degree", "bootstrap band over piles of arching_mean, lower"),
+            "arching_hi": one((Z, Hd), arch_hi, "degree", "bootstrap band over piles of arching_mean, upper"),
+            "arching_size_diff": one((Z, Hd), arch_mean - arch_mean[:1], "degree",
+                                     "arching_mean minus that of the smallest size"),
+            "arching_size_p": one((Z, Hd), arch_p, "1", "two-sided permutation p-value of arching_size_diff "
+                                                        "(size labels over piles; NaN: smallest size)"),
+            "deviation_median": one((Z, Hd, F, Q), stack("deviation_median"), "degree",
+                                    "median over piles of the cut deviation"),
+            "deviation_median_lo": one((Z, Hd, F, Q), stack("deviation_median_lo"), "degree",
+                                       "bootstrap band over piles of the median deviation, lower"),
+            "deviation_median_hi": one((Z, Hd, F, Q), stack("deviation_median_hi"), "degree",
+                                       "bootstrap band over piles of the median deviation, upper"),
+            "surface_angle": one((Z, Hd), np.array([an.surface_angle.mean(("pile", "flank")).values for an in ans]),
+                                 "degree", "flank slope, mean over piles and flanks"),
+            "apex_height": one((Z, Hd), mean_over("apex_height"), "1", "apex height in d, mean over piles"),
+            "half_width": one((Z, Hd), mean_over("fit_half_width") / d, "1",
+                              "toe-to-toe half-width of the pile's own fit in d, mean over piles"),
+            "cone_ratio": one((Z, Hd), mean_over("cone_ratio"), "1", "cone ratio, mean over piles"),
+        },
+        coords={Z: np.arange(S), Hd: hist, P: np.arange(n_max), Kd: K, F: ref.flank.values,
+                Q: ref.cut_position.values},
+        attrs={"level": a["level"], "bootstrap": a["bootstrap"], "permutations": a["permutations"],
+               "dip_center": a["dip_center"], "dip_flank": list(a["dip_flank"])},
+    )
+    out[Z].attrs.update(units="1", long_name="size index (grain counts ascending)")
+    out[Kd].attrs.update(units="1", long_name="kernel standard deviation in mean grain diameters")
+    out[Q].attrs.update(units="1", long_name="cut position |x| / base half-width")
+    return out
+
+
+COLORS = {"point": "C3", "rain": "C0"}
+
+
+def figure(sz):
+    """(a) dip of the mean profile, (b) arching deviation, (c) flank slope, against grains per
+    pile, per history with bands over piles; (d) median deviation against cut position per size."""
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(1, 4, figsize=(14, 3.6), constrained_layout=True)
+    n = sz.grains.values
+    k0 = sz.kernel.values[0]
+    for j, h in enumerate(sz.history.values):
+        s = sz.sel(history=h)
+        off = n * (1 + 0.04 * (2 * j - 1))
+        dm, dl, dh = (s[v].sel(kernel=k0).values for v in ("dip_mean", "dip_lo", "dip_hi"))
+        axes[0].errorbar(off, dm, yerr=[dm - dl, dh - dm], fmt="o-", color=COLORS.get(h), capsize=3, label=h)
+        am, al, ah = s.arching_mean.values, s.arching_lo.values, s.arching_hi.values
+        axes[1].errorbar(off, am, yerr=[am - al, ah - am], fmt="o-", color=COLORS.get(h), capsize=3, label=h)
+        axes[2].plot(n, s.surface_angle.values, "o-", color=COLORS.get(h), label=h)
+        for z in sz["size"].values:
+            med = s.deviation_median.sel(size=z).median("flank").values
+            axes[3].plot(sz.cut_position.values, med, "-" if z == sz["size"].values[-1] else "--",
+                         color=COLORS.get(h), alpha=0.5 + 0.5 * z / max(1, sz.sizes["size"] - 1),
+                         label=f"{h}, {int(n[z])} grains")
+    axes[0].axhline(0, color="k", lw=0.5)
+    axes[0].set_ylabel(f"dip of the mean profile (kernel {k0:g} d)")
+    axes[1].axhline(0, color="k", lw=0.5)
+    axes[1].set_ylabel("arching: median cut deviation (°)")
+    axes[2].set_ylabel("flank slope (°)")
+    axes[3].axhline(0, color="k", lw=0.5)
+    axes[3].set_xlabel("cut position |x| / L")
+    axes[3].set_ylabel("median deviation over piles (°)")
+    for ax, t in zip(axes, "abcd"):
+        ax.set_title(f"({t})", loc="left")
+        if t != "d":
+            ax.set_xscale("log")
+            ax.set_xlabel("grains per pile")
+        ax.legend(fontsize=7)
+    return fig
+
+
+def summary(sz):
+    """Numbers for the prose: per history, the smallest and largest sizes and their change."""
+    k0 = sz.kernel.values[0]
+    last = sz.sizes["size"] - 1
+    out = {"grains": [int(g) for g in sz.grains.values], "piles": [int(p) for p in sz.piles.values], "kernel": float(k0)}
+    for h in sz.history.values:
+        s = sz.sel(history=h)
+        out[h] = {q: [float(v) for v in s[q].sel(kernel=k0).values] for q in ("dip_mean", "dip_lo", "dip_hi")}
+        out[h].update({q: [float(v) for v in s[q].values] for q in
+                       ("arching_mean", "arching_lo", "arching_hi", "surface_angle", "apex_height", "half_width",
+                        "cone_ratio")})
+        out[h]["dip_p"] = float(s.dip_size_p.sel(kernel=k0, size=last))
+        out[h]["dip_p_kernels"] = {float(k): float(s.dip_size_p.sel(kernel=k, size=last)) for k in sz.kernel.values}
+        out[h]["arching_p"] = float(s.arching_size_p.sel(size=last))
+        out[h]["arching_change"] = float(s.arching_size_diff.sel(size=last))
+        out[h]["dip_change"] = float(s.dip_size_diff.sel(kernel=k0, size=last))
+    return out
+
+
+__all__ = ["size_dataset", "figure", "summary"]

@@ -1,0 +1,17 @@
+"""Issue 16, item 4: the analyses of every pile size side by side (size.nc)."""
+import xarray as xr
+
+from ncd.figures import history_size
+from ncd.io import provenance, write_dataset
+from ncd.pipeline import start
+
+log = start(snakemake)  # noqa: F821 (snakemake is injected)
+analyses = [xr.load_dataset(p) for p in snakemake.input.analyses]  # noqa: F821
+out = history_size.size_dataset(analyses, seed=snakemake.params.seed)  # noqa: F821
+out.attrs.update(provenance({"seed": snakemake.params.seed, "analyses": len(analyses)}))  # noqa: F821
+write_dataset(out, snakemake.output[0])  # noqa: F821
+for h in out.history.values:
+    s = out.sel(history=h)
+    log.info("%s: grains %s, dip %s, arching %s deg (p %s)", h, out.grains.values.tolist(),
+             s.dip_mean.isel(kernel=0).values.round(3).tolist(), s.arching_mean.values.round(2).tolist(),
+             s.arching_size_p.values.round(3).tolist())
