@@ -99,6 +99,29 @@ def _solve_spd(A, b, n, reg):
 
 
 @njit(cache=True, error_model="numpy")
+def _dots(a, b, c):
+    """``(a . b, a . c)`` in one pass, four partial sums each (a fixed order: the same bits
+    on every machine and thread count, and no chain of dependent additions)."""
+    n = a.shape[0]
+    s0 = s1 = s2 = s3 = 0.0
+    t0 = t1 = t2 = t3 = 0.0
+    n4 = n - n % 4
+    for i in range(0, n4, 4):
+        s0 += a[i] * b[i]
+        s1 += a[i + 1] * b[i + 1]
+        s2 += a[i + 2] * b[i + 2]
+        s3 += a[i + 3] * b[i + 3]
+        t0 += a[i] * c[i]
+        t1 += a[i + 1] * c[i + 1]
+        t2 += a[i + 2] * c[i + 2]
+        t3 += a[i + 3] * c[i + 3]
+    for i in range(n4, n):
+        s0 += a[i] * b[i]
+        t0 += a[i] * c[i]
+    return (s0 + s1) + (s2 + s3), (t0 + t1) + (t2 + t3)
+
+
+@njit(cache=True, error_model="numpy")
 def _anderson_step(data, aa):
     """After a sweep (``imp`` = G(x), ``x`` its input): record the differences and put the
     extrapolated, cone-projected iterate in ``imp``, the body velocities recomputed."""
@@ -106,10 +129,9 @@ def _anderson_step(data, aa):
     m, body0, x, f_prev, g_prev, dF, dG, gram, counters, mark = aa
     n2 = imp.shape[0]
     counters[3] += 1
-    fn = 0.0
     for i in range(n2):
-        fn += (imp[i] - x[i]) ** 2
-    fn = np.sqrt(fn)
+        x[i] = imp[i] - x[i]                  # x <- f = G(x) - x
+    fn = np.sqrt(_dots(x, x, x)[0])
     if fn < STALL_FACTOR * mark[0]:
         mark[0] = fn
         counters[4] = counters[3]
@@ -122,33 +144,24 @@ def _anderson_step(data, aa):
         counters[7] = m * 2 ** min(counters[5] - 1, 20)
         mark[0] = fn
         return
+    h = counters[0]
+    j = counters[1]
     if counters[2] == 1:                      # a previous pair (x, G(x)): one more column
-        j = counters[1]
         for i in range(n2):
-            dF[j, i] = imp[i] - x[i] - f_prev[i]
+            dF[j, i] = x[i] - f_prev[i]
             dG[j, i] = imp[i] - g_prev[i]
-        h = min(counters[0] + 1, m)
-        for slot in range(h):
-            s = 0.0
-            for i in range(n2):
-                s += dF[j, i] * dF[slot, i]
-            gram[j, slot] = s
-            gram[slot, j] = s
+        h = min(h + 1, m)
         counters[0] = h
         counters[1] = (j + 1) % m
-    for i in range(n2):
-        f_prev[i] = imp[i] - x[i]
-        g_prev[i] = imp[i]
+    f_prev[:] = x
+    g_prev[:] = imp
     counters[2] = 1
-    h = counters[0]
     if h == 0:
         return
     rhs = np.zeros(h)
-    for a in range(h):
-        s = 0.0
-        for i in range(n2):
-            s += dF[a, i] * f_prev[i]
-        rhs[a] = s
+    for slot in range(h):                     # the new column's Gram row and the right-hand side
+        gram[j, slot], rhs[slot] = _dots(dF[slot], dF[j], x)
+        gram[slot, j] = gram[j, slot]
     gamma = _solve_spd(gram, rhs, h, REGULARIZATION)
     for a in range(h):
         ga = gamma[a]

@@ -1,5 +1,6 @@
-"""Time to tolerance of one step problem: plain NLGS and NLGS + finishing stage side by side
-(issue 13, item 2; the benchmark ``bench_tolerance``).  Measurements, not tests."""
+"""Time to tolerance of one step problem: plain NLGS, NLGS + finishing stage and
+Anderson-accelerated NLGS (:mod:`ncd.anderson`) side by side (issue 13, item 2; the
+benchmark ``bench_tolerance``).  Measurements, not tests."""
 import time
 
 import numpy as np
@@ -10,7 +11,7 @@ from .finish import check_solution
 from .nlgs import SolverSettings
 from .stepper import solve_problem
 
-METHODS = ("nlgs", "nlgs+finish")
+METHODS = ("nlgs", "nlgs+finish", "anderson")
 FIELDS = {"seconds": ("s", "wall time to reach the tolerance (or to give up)"),
           "residual": ("1", "relative natural-map residual reached"),
           "sweeps": ("1", "NLGS sweeps"),
@@ -24,18 +25,21 @@ FIELDS = {"seconds": ("s", "wall time to reach the tolerance (or to give up)"),
 def time_to_tolerance(scene, problem, tols, handoff, max_sweeps, orders=(None,), check_every=10, log=None,
                       label=""):
     """Per review order (None: identity), method and tolerance: a run from the zero guess.
-    Plain NLGS runs to ``tol``; the finished run hands over at ``max(tol, handoff)`` and
-    finishes to ``tol`` (``finish="active_set"``).  Returns a dict of arrays (order, method, tol)."""
+    Plain NLGS and the accelerated run (``accel="anderson"``, default memory) run to ``tol``;
+    the finished run hands over at ``max(tol, handoff)`` and finishes to ``tol``
+    (``finish="active_set"``).  Returns a dict of arrays (order, method, tol)."""
     shape = (len(orders), len(METHODS), len(tols))
     out = {k: np.zeros(shape) for k in FIELDS}
     c = problem.contacts
     g = float(np.linalg.norm(scene.gravity)) or 1.0
-    solve_problem(scene, problem, settings=SolverSettings(tol=1.0, max_sweeps=1, finish="active_set"))   # warm-up
+    for accel in ("none", "anderson"):                                                              # warm-up
+        solve_problem(scene, problem, settings=SolverSettings(tol=1.0, max_sweeps=3, finish="active_set", accel=accel))
     for i, order in enumerate(orders):
         for j, method in enumerate(METHODS):
             for k, tol in enumerate(tols):
-                settings = (SolverSettings(tol=tol, max_sweeps=max_sweeps, check_every=check_every)
-                            if method == "nlgs" else
+                settings = (SolverSettings(tol=tol, max_sweeps=max_sweeps, check_every=check_every,
+                                           accel="anderson" if method == "anderson" else "none")
+                            if method != "nlgs+finish" else
                             SolverSettings(tol=max(tol, handoff), max_sweeps=max_sweeps, check_every=check_every,
                                            finish="active_set", finish_tol=tol))
                 t0 = time.perf_counter()
