@@ -10,20 +10,32 @@ method, type II ("Anderson mixing", Walker & Ni 2011), keeps the last ``m`` diff
 ``proj_C`` projecting each contact's impulse on its Coulomb cone (the body velocities
 are then recomputed, :func:`ncd.nlgs_pack._apply_all`).  ``gamma`` solves the ``m x m``
 normal equations with a Tikhonov term (:data:`REGULARIZATION` times their largest
-diagonal entry) by Cholesky.  Measured choices (fig2's step, 545 contacts, 6 review
-orders; dense packings):
+diagonal entry) by Cholesky.  Choices by measurement (fig2's step, 545 contacts, 6
+review orders; dense packings):
 
 * an Anderson step after every :data:`PERIOD`-th sweep only ("alternating" Anderson,
-  Pratapa, Suryanarayana & Pask 2016): half the cost of the extrapolations, as few sweeps;
-* safeguard: when ``|f|`` has not dropped below :data:`STALL_FACTOR` of its last mark
-  within ``STALL_SPAN m`` sweeps, the history is cleared and ``m 2^(r-1)`` plain sweeps
-  follow the ``r``-th restart.  Without it 1 run in 3-6 stagnated at residuals 1e-3 to
-  1e-5 on fig2's step (status switching defeats the extrapolation); with it every run
-  converged.
+  Pratapa, Suryanarayana & Pask 2016): an extrapolation costs about a sweep; to 1e-10 on
+  fig2's step (memory 20) one after every sweep took 590-710 sweeps, after every 2nd
+  610-940, every 3rd or 4th up to 2,800 (more stalls);
+* safeguard: when ``|f|`` (at the Anderson steps) has not dropped below :data:`STALL_FACTOR` of its last mark
+  within ``STALL_SPAN m`` Anderson steps, the history is cleared and ``m 2^(r-1)`` plain
+  sweeps follow the ``r``-th restart.  Without it 1 run in 3 to 6 stagnated at residuals
+  1e-3 to 1e-5 on fig2's step (status switching defeats the extrapolation); with it all
+  6 reached 1e-10.  (Restarting only when ``|f|`` grows did not cure the stagnation.)
+
+Measured to a residual of 1e-10 from the zero guess, memory 20 (NLGS sweeps, plain
+NLGS's in brackets): fig2's step 610-940 (8,720-8,890); 10^3-disc packing 190-210
+(3,440-3,790); 10^4-disc packing 1,090 (29,530).  Wall time 5-6x, 9-11x and ~10x
+shorter.  The pile's final state (Figure 4) is not helped: NLGS and AA both stall at
+residuals ~1e-6 (``finish="active_set"``, :mod:`ncd.finish`, is the route there); AA
+without the safeguard, memory 50 or 100, jumped from ~1e-6 to below 1e-10 in 3 of 12
+runs (3 review orders) and stalled in the others.
 
 The natural-map residual, the stopping test and the best-iterate record are those of
 :mod:`ncd.nlgs`, evaluated on sweep outputs only: the returned impulses and body
-velocities are always those of a sweep, consistent with each other.
+velocities are always those of a sweep, consistent with each other.  In chunked runs
+(an ``observe`` callable, :mod:`ncd.convergence`) the last sweep of a chunk is not
+extrapolated; the history goes on across chunks.
 """
 import numpy as np
 
@@ -35,7 +47,7 @@ from .nlgs_pack import C_MU, N_COEF, _apply_all
 PERIOD = 2                # an Anderson step after every PERIOD-th sweep
 REGULARIZATION = 1e-12    # Tikhonov term of the normal equations, relative to their largest diagonal entry
 STALL_FACTOR = 0.9        # |f| must drop below this fraction of its mark ...
-STALL_SPAN = 2            # ... within STALL_SPAN * m sweeps, or the history restarts
+STALL_SPAN = 2            # ... within STALL_SPAN * m Anderson steps, or the history restarts
 # counters of a run (one int64 array): stored columns, next slot, a previous pair (0/1),
 # Anderson steps, step of the |f| mark, restarts, sweep phase, plain sweeps to go
 N_COUNTERS = 8

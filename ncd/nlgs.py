@@ -78,7 +78,7 @@ class SolverSettings:
                 raise ValueError(f"{name} = {getattr(self, name)!r} must be > 0")
         if not isinstance(self.accel, str) or self.accel not in ACCELS:
             raise checks.InputError(f"settings.accel = {self.accel!r} must be one of {ACCELS}")
-        object.__setattr__(self, "accel_memory", checks.integer("settings.accel_memory", self.accel_memory, 0, 1000))
+        object.__setattr__(self, "accel_memory", checks.integer("settings.accel_memory", self.accel_memory, 0, 100))
 
     def as_attrs(self):
         return {f"solver_{k}": int(v) if isinstance(v, bool) else v for k, v in asdict(self).items()}
