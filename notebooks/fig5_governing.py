@@ -46,9 +46,9 @@
 # **Flows across parameters** (items 2 and 3 of issue 15). Figure 2's flow (the discs of
 # `fig2_slope.scene` on its rough periodic ground) is released at several friction
 # coefficients, time steps and slope angles, one factor at a time around Figure 2's
-# setting, several flows (seeds) per setting. One deposit per $(\mu, \text{seed})$ is shared
-# by every setting of that $\mu$ (the deposit, under gravity normal to the ground, does not
-# see $h$ or the slope). At fixed times after release each flow's next step is scanned as
+# setting, several flows (seeds) per setting. Every setting of a seed is released from the
+# same deposit, built under gravity normal to the ground at the base's $\mu$: a setting
+# changes its one parameter at the release and nothing else. At fixed times after release each flow's next step is scanned as
 # Figure 2's scan does: zero-guess and warm-start NLGS runs with random review orders to a
 # natural-map residual $\le 10^{-8}$ with the grain accelerations settled (unconverged runs
 # are counted and left out: the first steps after release, grains nearly at rest under heavy

@@ -4,9 +4,10 @@ The flow is Figure 2's (:mod:`.slope`: ``fig2_slope.scene`` and ``deposit``, dis
 rough periodic ground).  The design is one factor at a time around Figure 2's flow
 (``flows.base``: mu 0.5, h 5e-4 s, 24 deg): the extra values of ``flows.mu``,
 ``flows.h`` and ``flows.slope_deg`` each change one parameter (:func:`settings_table`),
-``flows.seeds`` flows per setting.  A deposit (under gravity normal to the ground, so
-independent of h and slope) depends on the seed and the friction only: one deposit per
-``(mu, seed)`` is shared by every setting of that mu (:func:`deposit_dataset`).
+``flows.seeds`` flows per setting.  Every setting of a seed is released from the same
+deposit (:func:`deposit_dataset`: under gravity normal to the ground, at the base's mu):
+a setting changes its one parameter at the release only, so the settings of a seed differ
+in that parameter and nothing else (deposits per mu took a tenth of the figure's time).
 
 Each flow is released (gravity tilted), stepped with warm starts for ``duration``
 seconds, and scanned at the same times ``scan_every, 2 scan_every, ...`` whatever h
@@ -84,9 +85,9 @@ def settings_table(f):
             "factor": fac.astype(np.int8)}
 
 
-def deposit_mus(f):
-    """The friction coefficients that need a deposit (sorted): the base's and ``flows.mu``."""
-    return np.unique([f["base"]["mu"], *f["mu"]]).astype(float)
+def deposit_mu(f):
+    """The friction coefficient of the deposits: the base's (every setting is released from it)."""
+    return float(f["base"]["mu"])
 
 
 def scan_times(f):
@@ -103,9 +104,9 @@ def _scene_cfg(cfg, mu, seed):
     return p
 
 
-def deposit_dataset(cfg, mu_index, seed, progress=None):
-    """Deposit of seed ``seed`` at friction ``deposit_mus[mu_index]`` -> Dataset (dim disc)."""
-    mu = float(deposit_mus(cfg["flows"])[mu_index])
+def deposit_dataset(cfg, seed, progress=None):
+    """Deposit of seed ``seed`` at the base's friction (:func:`deposit_mu`) -> Dataset (dim disc)."""
+    mu = deposit_mu(cfg["flows"])
     c = {"scene": _scene_cfg(cfg, mu, seed), "deposit": cfg["deposit"]}
     scene, dep = slope.deposit(c, progress)
     snap = slope.snapshot(scene)
@@ -277,5 +278,5 @@ def flow_dataset(dep, cfg, setting, seed, progress=None):
     return ds
 
 
-__all__ = ["FACTORS", "settings_table", "deposit_mus", "scan_times", "deposit_dataset", "scene_of_deposit",
+__all__ = ["FACTORS", "settings_table", "deposit_mu", "scan_times", "deposit_dataset", "scene_of_deposit",
            "scan_step", "run_flow", "flow_dataset"]

@@ -117,7 +117,7 @@ rule fig5_governing:
 
 # Flows (items 2-3 of issue 15): Figure 2's flow across mu, h and slope, one factor at a
 # time around Figure 2's setting; scans of distinct solutions and why a line.
-#   deposit   one deposit per (mu, seed), shared by the settings of that mu -> shards/deposit_mu<m>_seed<s>.nc
+#   deposit   one deposit per seed (at the base mu), shared by every setting -> shards/deposit_seed<s>.nc
 #   flow      one flow per (setting, seed), scanned                       -> shards/flow_<i>_seed<s>.nc
 #   flows     every flow                                                  -> flows.nc
 from ncd.figures import governing_flow as _gflow
@@ -126,9 +126,8 @@ FLOWS = CFG["flows"]
 FLOW_CFG = {"scene": section("fig2_slope")["scene"], "deposit": section("fig2_slope")["deposit"],
             "flows": without_shards(FLOWS)}
 DEPOSIT_CFG = {"scene": FLOW_CFG["scene"], "deposit": FLOW_CFG["deposit"],
-               "flows": {"base": {"mu": FLOWS["base"]["mu"]}, "mu": FLOWS["mu"], "root_seed": FLOWS["root_seed"]}}
+               "flows": {"base": {"mu": FLOWS["base"]["mu"]}, "root_seed": FLOWS["root_seed"]}}
 FLOW_MU = _gflow.settings_table(FLOWS)["mu"]
-DEPOSIT_MU = list(_gflow.deposit_mus(FLOWS))
 FLOW_SHARDS = [f"{F5}/shards/flow_{i}_seed{s}.nc" for i in range(len(FLOW_MU)) for s in range(FLOWS["seeds"])]
 
 
@@ -136,16 +135,15 @@ rule fig5_governing_deposit:
     input:
         ncd_sources(FIG),
     output:
-        temp(f"{F5}/shards/deposit_mu{{m}}_seed{{s}}.nc"),
+        temp(f"{F5}/shards/deposit_seed{{s}}.nc"),
     wildcard_constraints:
-        m=r"\d+",
         s=r"\d+",
     params:
         config=DEPOSIT_CFG,
     log:
-        log(FIG, "deposit_mu{m}_seed{s}"),
+        log(FIG, "deposit_seed{s}"),
     benchmark:
-        bench(FIG, "deposit_mu{m}_seed{s}")
+        bench(FIG, "deposit_seed{s}")
     conda:
         CONDA_ENV
     script:
@@ -155,7 +153,7 @@ rule fig5_governing_deposit:
 rule fig5_governing_flow:
     input:
         ncd_sources(FIG),
-        deposit=lambda w: f"{F5}/shards/deposit_mu{DEPOSIT_MU.index(FLOW_MU[int(w.i)])}_seed{w.s}.nc",
+        deposit=f"{F5}/shards/deposit_seed{{s}}.nc",
     output:
         temp(f"{F5}/shards/flow_{{i}}_seed{{s}}.nc"),
     wildcard_constraints:

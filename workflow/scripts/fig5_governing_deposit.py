@@ -1,10 +1,10 @@
-"""Figure 5: the deposit of one (mu, seed), shared by the flows of that mu (shards/deposit_mu<m>_seed<s>.nc)."""
+"""Figure 5: the deposit of one seed, shared by every setting of that seed (shards/deposit_seed<s>.nc)."""
 from ncd.figures import governing_flow
 from ncd.io import write_dataset
 from ncd.pipeline import Progress, start
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)
-m, s = int(snakemake.wildcards.m), int(snakemake.wildcards.s)  # noqa: F821
-ds = governing_flow.deposit_dataset(snakemake.params.config, m, s, Progress(log, 0, "deposit"))  # noqa: F821
+s = int(snakemake.wildcards.s)  # noqa: F821
+ds = governing_flow.deposit_dataset(snakemake.params.config, s, Progress(log, 0, "deposit"))  # noqa: F821
 write_dataset(ds, snakemake.output[0])  # noqa: F821
 log.info("deposit mu %.3g seed %d: %d steps", ds.attrs["mu"], s, ds.attrs["deposit_steps"])
