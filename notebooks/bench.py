@@ -181,12 +181,12 @@ display(Markdown(
     f"{float(n_.kinetic_energy):.1e} of Σ m g d)."))
 
 # %% [markdown]
-# ## Time to tolerance: plain NLGS and NLGS + finishing stage
+# ## Time to tolerance: plain NLGS, NLGS + finishing stage, Anderson-accelerated NLGS
 #
 # One step from rest of each dense packing, zero guess: plain NLGS run to each tolerance,
-# and NLGS followed by the finishing stage (`ncd.finish`: when NLGS's own rate predicts the
+# NLGS followed by the finishing stage (`ncd.finish`: when NLGS's own rate predicts the
 # tolerance beyond its budget, the iterate is projected by LP onto the solutions sharing its
-# contact statuses), to the same tolerance.
+# contact statuses), and Anderson-accelerated NLGS (`ncd.anderson`), to the same tolerance.
 
 # %%
 tt = tol_ds.to_dataframe().reset_index()

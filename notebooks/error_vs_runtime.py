@@ -34,7 +34,8 @@
 #    (a few hundred discs by default) — every setting (initial guess zero or warm,
 #    stopping criterion natural-map residual or impulse change, or NLGS with the finishing
 #    stage of `ncd.finish` (criterion `finish`: NLGS to $10^{-4}$, then, where NLGS's rate
-#    is slow, the projection on the polyhedron of its contact statuses), tolerance) gives one
+#    is slow, the projection on the polyhedron of its contact statuses), or Anderson-accelerated
+#    NLGS (criterion `anderson`, `ncd.anderson`), tolerance) gives one
 #    point: its wall time (best of a few repeats), its sweeps, its relative natural-map
 #    residual $|s - \mathrm{proj}_K(s - \rho\tilde U)|/\max(|s|, |\rho q|)$ and its
 #    distance to the limit of the same iteration (same guess, same review order) run to
@@ -100,7 +101,7 @@ for j, state in enumerate(nl.state.values):
     for xkey, row in (("wall_time", 0), ("sweeps", 1)):
         ax = axes[row, j]
         for init in d.init.values:
-            for crit, style in (("residual", "-"), ("change", ":"), ("finish", "-.")):
+            for crit, style in (("residual", "-"), ("change", ":"), ("finish", "-."), ("anderson", (0, (5, 1, 1, 1, 1, 1)))):
                 if crit not in d.criterion.values:
                     continue
                 e = d.sel(init=init, criterion=crit)

@@ -138,4 +138,6 @@ def test_tolerance_table_both_methods_reach_the_tolerance():
     assert (ds.finish_rounds.sel(solver="nlgs").values == 0).all()
     # NLGS converges at a steady rate on a dense packing: the finishing stage leaves it to NLGS (no LP)
     assert (ds.finish_rounds.sel(solver="nlgs+finish").values == 0).all()
+    # Anderson acceleration: fewer sweeps than plain NLGS to every tolerance on the dense packing
+    assert (ds.sweeps.sel(solver="anderson").values < ds.sweeps.sel(solver="nlgs").values).all()
     assert ds.seconds.attrs["units"] == "s"

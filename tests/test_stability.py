@@ -178,8 +178,11 @@ def test_nlgs_tighter_tolerance_never_larger_error(nlgs):
                 assert np.all(np.diff(e.sweeps.values) >= 0), (state, init, crit)
                 conv = e.converged.values.astype(bool)
                 assert conv.all(), (state, init, crit)
-                if crit == "residual":
+                if crit in ("residual", "anderson"):
                     assert np.all(e.residual.values <= e.tol.values)
+                if crit == "anderson":
+                    # the limit is plain NLGS's: accelerated runs may end elsewhere in an indeterminate set
+                    continue
                 for key in ("error_velocity", "error_impulse"):
                     v = e[key].values
                     assert np.all(v[1:] <= v[:-1] * (1 + 1e-9) + 1e-15), (state, init, crit, key, v)

@@ -247,12 +247,12 @@ def sweeps_table(cfg, log=None):
 
 
 def tolerance_table(cfg, log=None):
-    """Time to tolerance, plain NLGS and NLGS + finishing stage side by side: one step
+    """Time to tolerance, plain NLGS, NLGS + finishing stage and Anderson-accelerated NLGS side by side: one step
     from rest of each dense packing, zero guess, identity review order.  Plain NLGS runs
     to each ``tolerances`` value; the finished run hands over at ``handoff`` and polishes
     to the same value (``finish="active_set"``, :mod:`ncd.finish`).  -> Dataset
     (size, solver, tol): seconds, sweeps, residual, converged, finish rounds."""
-    sizes, tols, methods = cfg["sizes"], cfg["tolerances"], ["nlgs", "nlgs+finish"]
+    sizes, tols, methods = cfg["sizes"], cfg["tolerances"], ["nlgs", "nlgs+finish", "anderson"]
     shape = (len(sizes), len(methods), len(tols))
     out = {k: np.zeros(shape) for k in ("seconds", "residual")}
     out.update({k: np.zeros(shape, np.int64) for k in ("sweeps", "converged", "finish_rounds")})
@@ -264,6 +264,9 @@ def tolerance_table(cfg, log=None):
             for k, tol in enumerate(tols):
                 if method == "nlgs":
                     settings = SolverSettings(tol=tol, max_sweeps=cfg["max_sweeps"], check_every=10)
+                elif method == "anderson":
+                    settings = SolverSettings(tol=tol, max_sweeps=cfg["max_sweeps"], check_every=10, accel="anderson",
+                                              accel_memory=20)
                 else:
                     settings = SolverSettings(tol=max(tol, cfg["handoff"]), max_sweeps=cfg["max_sweeps"],
                                               check_every=10, finish="active_set", finish_tol=tol)

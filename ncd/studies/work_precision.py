@@ -64,6 +64,7 @@ def _velocity_error(s, problem, vel, spin, vel_ref, spin_ref):
 
 
 FINISH_HANDOFF = 1e-4     # NLGS tolerance handed to the finishing stage (criterion "finish")
+ANDERSON_MEMORY = 20      # criterion "anderson": Anderson-accelerated NLGS (ncd.anderson), residual criterion
 
 
 def nlgs_work_precision(s, h, tols, inits, criteria, reference, repeats, max_sweeps):
@@ -71,7 +72,8 @@ def nlgs_work_precision(s, h, tols, inits, criteria, reference, repeats, max_swe
     dimensions ``(init, criterion, tol)``.
     Criterion ``"finish"``: NLGS to ``max(tol, FINISH_HANDOFF)``, then the finishing stage
     (:mod:`ncd.finish`: NLGS while its rate is good, else the projection on its statuses'
-    polyhedron) to ``tol``."""
+    polyhedron) to ``tol``.  Criterion ``"anderson"``: Anderson-accelerated NLGS
+    (:mod:`ncd.anderson`, memory :data:`ANDERSON_MEMORY`) to ``tol`` on the residual."""
     problem = prepare_step(s, h)
     guesses = {init: initial_guess(s, problem, init) for init in inits}
     ref_settings = SolverSettings(tol=reference["tol"], max_sweeps=reference["max_sweeps"])
@@ -86,6 +88,8 @@ def nlgs_work_precision(s, h, tols, inits, criteria, reference, repeats, max_swe
             for k, tol in enumerate(tols):
                 settings = (SolverSettings(tol=max(tol, FINISH_HANDOFF), max_sweeps=max_sweeps, finish="active_set",
                                            finish_tol=tol) if crit == "finish"
+                            else SolverSettings(tol=tol, max_sweeps=max_sweeps, accel="anderson",
+                                                accel_memory=ANDERSON_MEMORY) if crit == "anderson"
                             else SolverSettings(tol=tol, max_sweeps=max_sweeps, criterion=crit))
                 best = np.inf
                 for _ in range(repeats):
