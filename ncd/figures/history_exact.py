@@ -52,6 +52,9 @@ def exact_ranges(cfg, ds, log=None):
         bound.append(rng["bound"])
         fy_max.append(es.interval(C[2 * k + 1].toarray().ravel())[1])
         n_lp.append(es.n_lp - n0)
+        if log is not None:     # a 10^4-grain pile takes minutes per cut: show the progress
+            log.info("cut %d of %d: angle range [%.3f, %.3f] deg, %d LPs, %.0f s so far", k + 1, len(specs),
+                     amin[-1], amax[-1], n_lp[-1], time.perf_counter() - t0)
     amin, amax = np.asarray(amin), np.asarray(amax)
     outside = np.maximum(np.maximum(amin - phi_hist, phi_hist - amax), 0.0)
     if log is not None:
