@@ -4,30 +4,18 @@ import pytest
 
 import ncd
 from ncd import convergence, finish, finish_lp
-from ncd.contacts import local_velocity
 from ncd.finish import check_solution
 from ncd.local_solver import NO_CONTACT, STICK
 from ncd.scene import make_scene
 from ncd.studies import scenes
+from step_checks import contact_velocities as _velocities
+from step_checks import step_residual as _residual
 
 H = 1e-3
 
 
 def _rest_problem(scene):
     return ncd.prepare_step(scene, H, 1.0, vel=np.zeros_like(scene.vel), spin=np.zeros_like(scene.spin))
-
-
-def _velocities(problem, vel, spin):
-    c = problem.contacts
-    return local_velocity(c.body_a, c.body_b, c.normal, c.arm_a, c.arm_b, vel, spin, np.empty((c.n, 2))) + problem.bias
-
-
-def _residual(problem, impulse, vel, spin):
-    """The relative natural-map residual of :mod:`ncd.nlgs` from the end-of-step velocities."""
-    rho = 1.0 / problem.W[:, 0, 0]
-    q = _velocities(problem, problem.free_vel, problem.free_spin)
-    return finish.relative_residual(impulse, _velocities(problem, vel, spin), problem.contacts.mu, rho,
-                                    float(np.sqrt(np.sum((q * rho[:, None]) ** 2))))
 
 
 def _check(scene, problem, result, vel, spin):
