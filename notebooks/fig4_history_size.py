@@ -105,9 +105,8 @@ at the two sizes, their apex heights {P['apex_height'][0]:.0f} d and {P['apex_he
 half-widths of {P['half_width'][0]:.0f} d and {P['half_width'][-1]:.0f} d (cone ratios
 {P['cone_ratio'][0]:.2f} and {P['cone_ratio'][-1]:.2f}). The rain deposits have flanks of
 {R['surface_angle'][0]:.1f}° and {R['surface_angle'][-1]:.1f}° and cone ratios {R['cone_ratio'][0]:.2f} and
-{R['cone_ratio'][-1]:.2f}: a rain over the whole base builds a flat-topped layer, not a cone.
+{R['cone_ratio'][-1]:.2f} (1: a cone; below: flat-topped).
 
-**Limits.** The large size has only {piles[-1]} piles per history (about ten minutes of CPU
-each): its bands are wide, and a change smaller than them is not resolved. A claim about
+**Limits.** The large size has only {piles[-1]} piles per history: its bands are wide, and a change smaller than them is not resolved. A claim about
 size rests on these bands, not on one pile.
 """))

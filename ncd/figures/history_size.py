@@ -130,13 +130,12 @@ def size_dataset(analyses, seed=16):
     return out
 
 
-COLORS = {"point": "C3", "rain": "C0"}
-
-
 def figure(sz):
     """(a) dip of the mean profile, (b) arching deviation, (c) flank slope, against grains per
     pile, per history with bands over piles; (d) median deviation against cut position per size."""
     import matplotlib.pyplot as plt
+
+    from .history_plots import COLORS
     fig, axes = plt.subplots(1, 4, figsize=(14, 3.6), constrained_layout=True)
     n = sz.grains.values
     k0 = sz.kernel.values[0]
