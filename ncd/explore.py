@@ -100,6 +100,7 @@ def explore(scene, problem, members, root_seed, init="zero", review="random", gu
         "max_speed": np.zeros(len(members)),
         "observable_change": np.zeros(len(members)),
         "finish_rounds": np.zeros(len(members), np.int64),
+        "finish_correction": np.zeros(len(members)),
         "wall_time": np.zeros(len(members)),
     }
     warm = initial_guess(scene, problem, "warm") if init == "warm" else None
@@ -123,6 +124,7 @@ def explore(scene, problem, members, root_seed, init="zero", review="random", gu
         out["max_speed"][k] = max_speed(vel, spin, scene, problem.h)
         out["observable_change"][k] = result.observable_change
         out["finish_rounds"][k] = result.finish_rounds
+        out["finish_correction"][k] = result.finish_correction
 
     run_parallel(run, len(members), threads, progress)
     return out

@@ -40,6 +40,7 @@ KNOWN = {
     "max_speed": ("1", "largest grain speed / (|g| h)"),
     "observable_change": ("1", "largest relative change of the figure's observable over the last checks"),
     "finish_rounds": ("1", "LP solves of the exact finishing stage"),
+    "finish_correction": ("1", "relative L1 move of the impulses by the finishing projection (0: none)"),
     "n_contacts": ("1", "number of contacts"), "n_discs": ("1", "number of discs"),
     "n_grains": ("1", "number of grains poured"), "n_steps": ("1", "number of time steps"),
     "unconverged_steps": ("1", "time steps whose NLGS did not converge"),

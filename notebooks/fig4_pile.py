@@ -62,10 +62,17 @@
 #    residual, converged flag and wall time; per run we keep the resultants of
 #    every cut, the ground force and pressure, and the end-of-step velocities'
 #    summary (a run whose grains do not all stay at rest is not an equilibrium).
+#    With `ensemble.finish: active_set` (the default) NLGS hands each run over
+#    at the ensemble's tolerance to the finishing stage (`ncd.finish`): the
+#    iterate is projected (L1, an LP) on the one-step solutions sharing its
+#    contact statuses, or else on the states at rest, and the projection is
+#    kept only if it is an exact solution within 5 % of the iterate. A run then
+#    ends on an exact solution, at rest or with grains moving, and is
+#    classified; only rest runs enter the clouds.
 #    *Tolerance study* (`tolerance.nc`): the first members again (same review
-#    orders), at tolerances from $10^{-3}$ to $10^{-6}$: a member's distance to
-#    its own tightest result is its iteration error, the spread among members
-#    at one tolerance is the cloud.
+#    orders), plain NLGS without finishing, at tolerances from $10^{-3}$ to
+#    $10^{-6}$: a member's distance to its own tightest result is its iteration
+#    error, the spread among members at one tolerance is the cloud.
 # 5. *Beyond the paper*: the ground pressure profile (vertical ground force per
 #    unit length) under the pile, history and ensemble band, against the weight
 #    of the column of grains above each bin.
@@ -411,6 +418,28 @@ Fmean = np.linalg.norm(P.mean(0)) if len(P) else np.nan
 clouds = [r[4] for r in rows]
 j_ens = int(np.argmin(np.abs(np.log(tol.tol.values / float(ens.tol)))))   # the study's row at the ensemble's tol
 n_oc = {o: int((ens.outcome.values == c).sum()) for c, o in ((1, "rest"), (2, "motion"), (0, "unconverged"))}
+fin = ens.attrs.get("finish", "none") != "none"
+
+
+def span(x, fmt):
+    """``"a–b"`` of the range of ``x`` in format ``fmt``, or ``"a"`` when both ends print the same."""
+    lo, hi = format(np.min(x), fmt), format(np.max(x), fmt)
+    return lo if lo == hi else f"{lo}–{hi}"
+if fin:
+    ok_f = ens.outcome.values > 0
+    proj = ok_f & (ens.finish_rounds.values > 0)
+    mot = ens.outcome.values == 2
+    finish_text = (
+        f" NLGS handed every run over at {float(ens.tol):g} to the finishing stage; {int(ok_f.sum())} runs ended on an "
+        f"exact solution (residual ≤ {ens.attrs['finish_tol']:g}; largest {stat(np.max, ens.residual.values[ok_f]):.1e}), "
+        f"{int(proj.sum())} of them by a projection that moved the impulses by "
+        f"{stat(np.min, ens.finish_correction.values[proj]):.1%}–{stat(np.max, ens.finish_correction.values[proj]):.1%} "
+        f"(L1), the others by NLGS alone; wall time {np.min(ens.wall_time):.1f}–{np.max(ens.wall_time):.1f} s per run. "
+        + (f"In the {int(mot.sum())} motion solutions {span(ens.n_moving.values[mot], '.0f')} grains move faster "
+           f"than {ens.attrs['moving_tol']:g} $g h$, the fastest at {span(ens.max_speed.values[mot], '.2f')} $g h$ "
+           "(1: free fall)." if mot.any() else ""))
+else:
+    finish_text = ""
 if conv.any():
     near = float(np.min(np.hypot(*(P - HIST[K]).T)))
     cloud_text = (
@@ -457,7 +486,7 @@ Markdown(f"""
 * **Iteration error vs indeterminacy.** {tol_text}
 * **Outcomes of the zero-guess runs.** Of {ens.sizes['run']} runs, {n_oc['rest']} converged at rest,
   {n_oc['motion']} converged with grains moving faster than the rest bound and {n_oc['unconverged']} did not
-  converge; only rest runs enter the clouds. Grains moving above {ens.attrs['moving_tol']:g} $g h$ per run:
+  converge; only rest runs enter the clouds.{finish_text} Grains moving above {ens.attrs['moving_tol']:g} $g h$ per run:
   median {np.median(ens.n_moving):.0f} over all runs. The warm-started history keeps every grain at rest
   ($|u_f| \\le$ {con.attrs['eq_max_velocity']:.1g} $g h$): section 5's "messages from history" in the small.
 * **Ground pressure (beyond the paper).** Fixed {cfg['pressure']['bin_d']:g} d bins hold a few ground contacts

@@ -193,14 +193,26 @@ def test_every_run_records_the_solver(data):
 
 
 def test_members_do_not_depend_on_the_shard(data):
-    """The tolerance study repeats members 0..k-1 of the ensemble (other shard count)."""
+    """A member's run depends on its member number only: the tolerance study repeats
+    members 0..k-1 of the ensemble with another shard count (plain NLGS: the same runs
+    where the ensemble is not finished); the last member of a finished ensemble, re-run
+    alone here, gives the same bits."""
     ens, tol = data["ensemble"], data["tolerance"]
-    if float(ens.tol) not in tol.tol.values:
-        pytest.skip("the ensemble tolerance is not in the study")
-    t = tol.sel(tol=float(ens.tol))
-    e = ens.sel(run=t.run.values)
-    for k in ("cut_force_x", "cut_force_y", "ground_pressure", "sweeps", "residual", "converged"):
-        np.testing.assert_array_equal(t[k].values, e[k].values)
+    keys = ("cut_force_x", "cut_force_y", "ground_pressure", "sweeps", "residual", "converged")
+    assert tol.attrs["finish"] == "none"
+    if ens.attrs["finish"] == "none":
+        assert float(ens.tol) in tol.tol.values
+        t = tol.sel(tol=float(ens.tol))
+        e = ens.sel(run=t.run.values)
+        for k in keys:
+            np.testing.assert_array_equal(t[k].values, e[k].values)
+        return
+    cfg = yaml.safe_load(ens.attrs["config_yaml"])
+    last = int(ens.run.values[-1])
+    again = pile.ensemble_shard(cfg, data["construction"], data["cuts"], [last], [float(ens.tol)],
+                                int(ens.attrs["root_seed"]))
+    for k in keys + ("outcome", "finish_correction"):
+        np.testing.assert_array_equal(again[k].isel(tol=0).values[0], ens[k].sel(run=last).values)
 
 
 def test_default_cut_resultant_is_parallel_to_the_surface(data):
@@ -216,20 +228,26 @@ def test_default_cut_resultant_is_parallel_to_the_surface(data):
         assert abs(dev) < MAX_DEVIATION_DEG
 
 
-def test_cloud_is_smaller_than_the_cut_sensitivity(data):
-    """Section 5: moving the cut by one diameter changes the resultant more than the
-    indetermination cloud spans."""
-    cuts, ens = data["cuts"], data["ensemble"]
+def test_cloud_against_the_exact_polygon_and_the_cut_sensitivity(data):
+    """Section 5 compares the cloud with the change of the resultant when the cut moves by
+    one diameter.  The cloud of the rest runs is a subset of the exact projection of
+    A ∩ C: its diameter is at most the polygon's, and the polygon is not a point (the
+    pile is indeterminate).  Whether the cloud is smaller than the cut change is measured
+    and reported (the notebook states it from these numbers), not assumed: at the
+    default size the finished runs' cloud is the wider of the two."""
+    cuts, ens, ex = data["cuts"], data["ensemble"], data["exact"]
+    W = ex.attrs["weight"]
     kind = list(cuts.kind.values)
     k, km, kp = kind.index("default"), kind.index("minus"), kind.index("plus")
     conv = pile_exact.rest_mask(ens)
-    if conv.sum() < 2:
-        pytest.skip(f"{conv.sum()} run(s) converged at rest: no cloud")
+    assert conv.sum() >= 2, f"{conv.sum()} run(s) converged at rest: no cloud"
     P = np.column_stack([ens.cut_force_x.values[conv, k], ens.cut_force_y.values[conv, k]])
-    diameter = np.max(np.hypot(*(P[:, None] - P[None]).transpose(2, 0, 1)))
+    diameter = pile_exact._diameter(P)
+    exact = pile_exact._diameter(pile_exact.polygon_of(ex, k))
+    assert 0.0 < diameter <= exact + 1e-8 * W, f"cloud {diameter:.4g} N, exact polygon {exact:.4g} N"
     F = np.column_stack([cuts.history_fx.values, cuts.history_fy.values])
     change = min(np.linalg.norm(F[km] - F[k]), np.linalg.norm(F[kp] - F[k]))
-    assert diameter < change, f"cloud diameter {diameter:.4g} N, cut change {change:.4g} N"
+    assert change > 1e-6 * W              # the shifted cuts cross other contacts
 
 
 def test_every_run_is_classified(data):

@@ -219,10 +219,15 @@ def _observable(cfg, scene, contacts, C, edges):
     return observe
 
 
-def ensemble_shard(cfg, construction, cuts, members, tolerances, root_seed, log=None):
+def ensemble_shard(cfg, construction, cuts, members, tolerances, root_seed, log=None, finish=None):
     """NLGS runs from the zero guess with random review orders on the final state
     (section 5), one set per tolerance; per run the cut resultants, the ground force
-    (total and per bin), the end-of-step velocities' summary and the solver record."""
+    (total and per bin), the end-of-step velocities' summary and the solver record.
+
+    ``finish`` (default ``cfg["ensemble"]["finish"]``): "active_set" hands each run over
+    at ``tol`` to the finishing stage (:mod:`ncd.finish`, to ``finish_tol``), an exact
+    solution whose observable has nothing left to settle, so the observable is not
+    tracked; "none": plain NLGS, converged only when the observable has settled too."""
     from ncd.pipeline import Progress
     e = cfg["ensemble"]
     h, g = cfg["h"], cfg["gravity"]
@@ -239,11 +244,12 @@ def ensemble_shard(cfg, construction, cuts, members, tolerances, root_seed, log=
         ("ground_pressure", (cuts.sizes["bin"],)), ("ground_fx", ()), ("ground_fy", ()),
         ("unbalanced_fy", ()), ("max_velocity", ()), ("n_moving", ()), ("sweeps", ()), ("residual", ()),
         ("change", ()), ("converged", ()), ("wall_time", ()), ("outcome", ()), ("max_speed", ()),
-        ("observable_change", ()), ("finish_rounds", ()))}
-    observe = _observable(cfg, scene, c, C, edges)
+        ("observable_change", ()), ("finish_rounds", ()), ("finish_correction", ()))}
+    finish = e.get("finish", "none") if finish is None else finish
+    observe = _observable(cfg, scene, c, C, edges) if finish == "none" else None
     for j, tol in enumerate(tolerances):
         settings = ncd.SolverSettings(tol=float(tol), max_sweeps=e["max_sweeps"], check_every=e["check_every"],
-                                      finish=e.get("finish", "none"), finish_tol=e.get("finish_tol", 1e-10),
+                                      finish=finish, finish_tol=e.get("finish_tol", 1e-10),
                                       observable_tol=e.get("observable_tol", 1e-6))
         prog = Progress(log, len(members), f"tol {tol:g}") if log is not None else None
         out = explore(scene, problem, members, root_seed, settings=settings, progress=prog, observe=observe)
@@ -259,7 +265,7 @@ def ensemble_shard(cfg, construction, cuts, members, tolerances, root_seed, log=
         res["n_moving"][:, j] = (speed > e["moving_tol"]).sum(axis=1)
         res["unbalanced_fy"][:, j] = out["vel"][..., 1] @ scene.mass[:nm] / h
         for k in ("sweeps", "residual", "change", "converged", "wall_time", "outcome", "max_speed",
-                  "observable_change", "finish_rounds"):
+                  "observable_change", "finish_rounds", "finish_correction"):
             res[k][:, j] = out[k]
         if log is not None:
             log.info("tol %g: %d runs, %d converged, sweeps %d..%d, mean %.3f s/run", tol, len(members),
@@ -274,14 +280,17 @@ def ensemble_shard(cfg, construction, cuts, members, tolerances, root_seed, log=
                                   "cut": cuts["cut"].values, "bin": cuts["bin"].values},
                     attrs=provenance(cfg, root_seed=root_seed, h=h, weight=construction.attrs["weight"],
                                      max_sweeps=e["max_sweeps"], check_every=e["check_every"],
-                                     moving_tol=e["moving_tol"], init="zero", review="random"))
+                                     moving_tol=e["moving_tol"], init="zero", review="random", finish=finish,
+                                     finish_tol=e.get("finish_tol", 1e-10) if finish != "none" else np.nan))
     ds["max_velocity"].attrs["units"] = "g h (largest |u_f| or |r w_f| over grains; 0 at equilibrium)"
     from ncd.convergence import MAX_SPEED_ATTRS, outcome_attrs
     ds["outcome"].attrs.update(outcome_attrs())
     ds["max_speed"].attrs.update(MAX_SPEED_ATTRS)
     ds["observable_change"].attrs.update(units="1", long_name="largest relative change of the observable (default "
                                          "cut resultant and kernel ground pressure, over the weight) over the last checks")
-    ds["finish_rounds"].attrs.update(units="1", long_name="active-set rounds of the finishing stage")
+    ds["finish_rounds"].attrs.update(units="1", long_name="LP projections of the finishing stage (0: none)")
+    ds["finish_correction"].attrs.update(units="1", long_name="relative L1 move of the impulses by the accepted "
+                                         "projection (0: NLGS got there, NaN: unconverged)")
     ds["unbalanced_fy"].attrs["note"] = "sum of m u_f,y / h: ground_fy - weight equals it exactly"
     ds["wall_time"].attrs["note"] = ("measured seconds per run, while the rule's other threads ran other members "
                                      "(the only non-reproducible variable)")
