@@ -186,7 +186,8 @@ display(Markdown(
 # One step from rest of each dense packing, zero guess: plain NLGS run to each tolerance,
 # NLGS followed by the finishing stage (`ncd.finish`: when NLGS's own rate predicts the
 # tolerance beyond its budget, the iterate is projected by LP onto the solutions sharing its
-# contact statuses), and Anderson-accelerated NLGS (`ncd.anderson`), to the same tolerance.
+# contact statuses, or, when there are none, onto the states at rest), and
+# Anderson-accelerated NLGS (`ncd.anderson`), to the same tolerance.
 
 # %%
 tt = tol_ds.to_dataframe().reset_index()
