@@ -33,8 +33,9 @@ guess, 32 random review orders, handing over at 1e-5: every run reaches a residu
 <= 1e-10 (largest 6e-11) in 2.6-6.9 s.  NLGS drifts near 1e-6 (its impulses change by
 a constant ~5e-10 per sweep), the polyhedron of its statuses is empty, and the nearest
 state at rest is 2.2-2.6 % away (L1): 28 runs end at rest (grains below 3e-11 g h).
-Four end on motion solutions with one grain or more in free fall (speed g h): two
-reached by NLGS alone, two by the status projection (0.7 % away).  HiGHS's crossover is
+Four end on a motion solution (a grain wedged between two neighbours falls free, speed
+g h, and 19 grains at the apex move at 0.01-0.7 g h): two reached by NLGS alone, two by
+the status projection (0.7 % away).  HiGHS's crossover is
 capped (:data:`ncd.finish_lp.SIMPLEX_LIMIT`): uncapped, one empty polyhedron kept it
 20 s without an answer.  Where NLGS converges at a steady rate (fig2's step, dense
 packings) the stage is NLGS itself.
