@@ -90,6 +90,7 @@ from IPython.display import Markdown
 
 from ncd.figures import cuts as cm
 from ncd.figures import pile_exact as pe
+from ncd.figures.pile_exact import diameter
 from ncd.figures import pressure as pm
 
 from ncd.notebook import paths, save
@@ -115,11 +116,6 @@ def cloud(ds, k, mask=None):
     """End points (F_x, F_y) of the resultant across cut k, one row per run."""
     P = np.column_stack([ds.cut_force_x.values[..., k], ds.cut_force_y.values[..., k]])
     return P if mask is None else P[mask]
-
-
-def diameter(P):
-    """Largest distance between two end points."""
-    return float(np.max(np.hypot(*(P[:, None] - P[None]).transpose(2, 0, 1)))) if len(P) > 1 else 0.0
 
 
 def stat(f, x):
@@ -471,7 +467,7 @@ if all(r[1] >= 2 for r in rows):
     tol_text = (
         f"From {tol.tol.values[0]:g} to {tol.tol.values[-1]:g} the median iteration error of a member (distance to its "
         f"own result at {tol.tol.values[-1]:g}) goes " + " → ".join(f"{r[5]:.2g}" for r in rows[:-1]) + " N, while the "
-        f"cloud of the same members goes " + " → ".join(f"{c:.2g}" for c in clouds) + " N (runs converged at rest at "
+        "cloud of the same members goes " + " → ".join(f"{c:.2g}" for c in clouds) + " N (runs converged at rest at "
         f"each tolerance: {counts}). "
         + ("The cloud does not shrink as the tolerance tightens: it is indeterminacy, not iteration error; "
            f"at the ensemble's tolerance {float(ens.tol):g} it is {clouds[j_ens] / clouds[-1]:.0%} of its size at "

@@ -230,7 +230,7 @@ def exact_text(exact, ens, cuts):
     for k, name in ((0, "default"), (1, "moved by -1 d"), (2, "moved by +1 d")):
         P, out, cov = cloud_in_polygon(exact, ens, k, mask)
         lines.append(f"Cut {name}: exact polygon of {int(exact.n_vertices[k])} vertices ({int(exact.n_lp[k])} LPs), "
-                     f"diameter {_diameter(polygon_of(exact, k)):.4f} N; the rest runs cover "
+                     f"diameter {diameter(polygon_of(exact, k)):.4f} N; the rest runs cover "
                      f"{100 * cov:.2g} % of its area and lie inside it to "
                      f"{(out.max() if len(out) else 0.0) / W:.1e} of the weight.")
     arch = exact.all_arch.values.astype(bool)
@@ -252,6 +252,8 @@ def exact_text(exact, ens, cuts):
     return "\n\n".join(lines)
 
 
-def _diameter(v):
+def diameter(v):
+    """Largest distance between two points of ``v`` (k, 2) in force space (0 for fewer than two):
+    the size of a cloud or of an exact polygon."""
     v = np.asarray(v).reshape(-1, 2)
     return float(np.hypot(*(v[:, None] - v[None]).transpose(2, 0, 1)).max()) if len(v) else 0.0
