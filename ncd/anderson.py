@@ -14,9 +14,10 @@ diagonal entry) by Cholesky.  Choices by measurement (fig2's step, 545 contacts,
 review orders; dense packings):
 
 * an Anderson step after every :data:`PERIOD`-th sweep only ("alternating" Anderson,
-  Pratapa, Suryanarayana & Pask 2016): an extrapolation costs about a sweep; to 1e-10 on
-  fig2's step (memory 20) one after every sweep took 590-710 sweeps, after every 2nd
-  610-940, every 3rd or 4th up to 2,800 (more stalls);
+  Pratapa, Suryanarayana & Pask 2016): an Anderson step with memory 20 costs 1.4 sweeps
+  on fig2's step (14 us against 10 us; 31 us before the Gram row's dot products were
+  vectorized, :func:`_dots`); to 1e-10 there, one after every sweep took 590-710 sweeps,
+  after every 2nd 610-940, every 3rd or 4th up to 2,800 (more stalls);
 * safeguard: when ``|f|`` (at the Anderson steps) has not dropped below :data:`STALL_FACTOR` of its last mark
   within ``STALL_SPAN m`` Anderson steps, the history is cleared and ``m 2^(r-1)`` plain
   sweeps follow the ``r``-th restart.  Without it 1 run in 3 to 6 stagnated at residuals
@@ -24,10 +25,11 @@ review orders; dense packings):
   6 reached 1e-10.  (Restarting only when ``|f|`` grows did not cure the stagnation.)
 
 Measured to a residual of 1e-10 from the zero guess, memory 20 (NLGS sweeps, plain
-NLGS's in brackets): fig2's step 610-940 (8,720-8,890); 10^3-disc packing 190-210
-(3,440-3,790); 10^4-disc packing 1,090 (29,530).  Wall time 5-6x, 9-11x and ~10x
-shorter.  The pile's final state (Figure 4) is not helped: NLGS and AA both stall at
-residuals ~1e-6 (``finish="active_set"``, :mod:`ncd.finish`, is the route there); AA
+NLGS's in brackets): fig2's step 620-900 over 6 review orders (8,720-9,070); 10^3-disc
+packing 190-210 (3,440-3,790); 10^4-disc packing 1,110 (29,530).  Wall time 5-8x,
+9-11x and 10.5x shorter: on fig2's step the sweep count falls 10-14x, and the Anderson
+steps take the rest.  The pile's final state (Figure 4) is not helped: NLGS and AA
+both stall at residuals ~1e-6 (``finish="active_set"``, :mod:`ncd.finish`, is the route there); AA
 without the safeguard, memory 50 or 100, jumped from ~1e-6 to below 1e-10 in 3 of 12
 runs (3 review orders) and stalled in the others.
 
@@ -110,27 +112,18 @@ def _solve_spd(A, b, n, reg):
     return x
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", fastmath={"reassoc"})
 def _dots(a, b, c):
-    """``(a . b, a . c)`` in one pass, four partial sums each (a fixed order: the same bits
-    on every machine and thread count, and no chain of dependent additions)."""
-    n = a.shape[0]
-    s0 = s1 = s2 = s3 = 0.0
-    t0 = t1 = t2 = t3 = 0.0
-    n4 = n - n % 4
-    for i in range(0, n4, 4):
-        s0 += a[i] * b[i]
-        s1 += a[i + 1] * b[i + 1]
-        s2 += a[i + 2] * b[i + 2]
-        s3 += a[i + 3] * b[i + 3]
-        t0 += a[i] * c[i]
-        t1 += a[i + 1] * c[i + 1]
-        t2 += a[i + 2] * c[i + 2]
-        t3 += a[i + 3] * c[i + 3]
-    for i in range(n4, n):
-        s0 += a[i] * b[i]
-        t0 += a[i] * c[i]
-    return (s0 + s1) + (s2 + s3), (t0 + t1) + (t2 + t3)
+    """``(a . b, a . c)`` in one pass.  ``reassoc`` (and no other fast-math flag) lets LLVM
+    vectorize the two sums (3x faster than a fixed scalar order; the Gram row was half
+    an Anderson step).  The summation order is then fixed by the compiled code: the same
+    bits on every run, thread count and shard of a given machine and numba build."""
+    s = 0.0
+    t = 0.0
+    for i in range(a.shape[0]):
+        s += a[i] * b[i]
+        t += a[i] * c[i]
+    return s, t
 
 
 @njit(cache=True, error_model="numpy")
@@ -162,11 +155,14 @@ def _anderson_step(data, aa):
         for i in range(n2):
             dF[j, i] = x[i] - f_prev[i]
             dG[j, i] = imp[i] - g_prev[i]
+            f_prev[i] = x[i]
+            g_prev[i] = imp[i]
         h = min(h + 1, m)
         counters[0] = h
         counters[1] = (j + 1) % m
-    f_prev[:] = x
-    g_prev[:] = imp
+    else:
+        f_prev[:] = x
+        g_prev[:] = imp
     counters[2] = 1
     if h == 0:
         return
@@ -175,10 +171,20 @@ def _anderson_step(data, aa):
         gram[j, slot], rhs[slot] = _dots(dF[slot], dF[j], x)
         gram[slot, j] = gram[j, slot]
     gamma = _solve_spd(gram, rhs, h, REGULARIZATION)
-    for a in range(h):
+    a = 0
+    while a + 4 <= h:                        # s -= dG gamma, four columns per pass over s
+        g0 = gamma[a]
+        g1 = gamma[a + 1]
+        g2 = gamma[a + 2]
+        g3 = gamma[a + 3]
+        for i in range(n2):
+            imp[i] -= (g0 * dG[a, i] + g1 * dG[a + 1, i]) + (g2 * dG[a + 2, i] + g3 * dG[a + 3, i])
+        a += 4
+    while a < h:
         ga = gamma[a]
         for i in range(n2):
             imp[i] -= ga * dG[a, i]
+        a += 1
     for c in range(n2 // 2):
         pn, pt = project_cone(imp[2 * c], imp[2 * c + 1], coef[N_COEF * c + C_MU])
         imp[2 * c] = pn
