@@ -30,7 +30,7 @@ states at rest, A ∩ C times ``h``) is tried the same way.
 
 Measured on the 1000-grain pile's final state (Figure 4, 1721 contacts) from the zero
 guess, 32 random review orders, handing over at 1e-5: every run reaches a residual
-<= 1e-10 (largest 9.99e-11) in 1.8-7.8 s.  NLGS drifts near 1e-6 (its impulses change by
+<= 1e-10 (largest 6e-11) in 2.6-6.9 s.  NLGS drifts near 1e-6 (its impulses change by
 a constant ~5e-10 per sweep), the polyhedron of its statuses is empty, and the nearest
 state at rest is 2.2-2.6 % away (L1): 28 runs end at rest (grains below 3e-11 g h).
 Four end on a motion solution (a grain wedged between two neighbours falls free, speed
@@ -38,8 +38,7 @@ g h, and 19 grains at the apex move at 0.01-0.7 g h): two reached by NLGS alone,
 the status projection (0.7 % away).  HiGHS's crossover is
 capped (:data:`ncd.finish_lp.SIMPLEX_LIMIT`): uncapped, one empty polyhedron kept it
 20 s without an answer.  Where NLGS converges at a steady rate (fig2's step, dense
-packings) the stage is NLGS itself, sweep for sweep (its chunks stop at the tolerance;
-they used to run to their end, 2.2x the sweeps on fig2's step).
+packings) the stage is NLGS itself.
 
 :func:`check_solution` checks a solution componentwise (cone, complementarity,
 sticking and sliding velocities).  :func:`project_statuses` (the minimum-norm point
@@ -62,7 +61,6 @@ MAX_ATTEMPTS = 3         # failed projections (an empty polyhedron costs 10-20 s
 REST_GATE = 1e-5         # the rest polyhedron is tried from iterates this close only (far ones: long LPs, rejected)
 MAX_CORRECTION = 0.05    # a projection moving the impulses by more (relative L1) is a jump: rejected
 LOG = logging.getLogger(__name__)
-CHECK_EVERY = 10         # sweeps between residual checks within a chunk of NLGS (a chunk stops at tol)
 REFINE = 30              # iterated-Tikhonov refinements of one minimum-norm correction (census)
 
 
@@ -157,9 +155,7 @@ def project_statuses(W, q, mu, s0, status):
 def polish(lp, W, q, mu, rho, scale, s0, status0, tol, more_sweeps, max_sweeps, sweeps0):
     """Finishing stage from the NLGS iterate ``s0`` (statuses ``status0``, after ``sweeps0`` sweeps).
 
-    NLGS goes on (``more_sweeps(k, tol) -> (s, status, sweeps made)``: at most ``k``
-    sweeps, fewer when its residual, checked every :data:`CHECK_EVERY` sweeps, reaches
-    ``tol``; a first chunk measures its rate)
+    NLGS goes on (``more_sweeps(k) -> (s, status)``; a first chunk measures its rate)
     while its rate predicts ``tol`` within :data:`LP_SWEEPS` sweeps.  Otherwise the
     iterate is projected on the polyhedron of its statuses (:func:`ncd.finish_lp.project`).
     A projection is accepted when its natural-map residual is
@@ -210,7 +206,7 @@ def polish(lp, W, q, mu, rho, scale, s0, status0, tol, more_sweeps, max_sweeps, 
             chunk *= 4
         if k <= 0:
             return best[1], best[2], best[0], solves, False, extra, float("nan")
-        s_new, status, k = more_sweeps(k, tol)
+        s_new, status = more_sweeps(k)
         status = np.where(status > SLIDE_BACKWARD, STICK, status).astype(np.int8)
         extra += k
         res_new = residual(s_new)
@@ -263,10 +259,10 @@ def polish_local(Wc, q, mu, Wd, data, order, result, settings):
     scale = _scale(q.reshape(n, 2), Wd)
     flat, status = data[6], result.status
 
-    def more(k, tol):
+    def more(k):
         keep = (np.array([-np.inf, 0.0, 0.0]), np.empty_like(flat), np.empty_like(status), np.empty(0), 0)
-        made = _iterate_local(data, order, status, scale, tol, k, 0, CHECK_EVERY, keep)[0]
-        return flat.reshape(n, 2).copy(), status.copy(), made
+        _iterate_local(data, order, status, scale, 0.0, k, 0, k, keep)
+        return flat.reshape(n, 2).copy(), status.copy()
 
     s0 = flat.reshape(n, 2).copy()
     lp = StatusLP.local(Wc, q, mu, max(float(np.abs(s0).max(initial=0.0)), scale / np.sqrt(n)),
@@ -286,10 +282,10 @@ def polish_discs(scene, contacts, vel, spin, bias, q_free, Wb, flat, order, resu
     body, imp, status = flat[2].reshape(-1, 4), flat[3], result.status
     s_start = imp.reshape(n, 2).copy()
 
-    def more(k, tol):
+    def more(k):
         keep = (np.array([-np.inf, 0.0, 0.0]), np.empty_like(imp), np.empty_like(status), np.empty_like(flat[2]), 0)
-        made = _iterate_discs(flat, order, status, scale, tol, k, 0, CHECK_EVERY, keep)[0]
-        return imp.reshape(n, 2).copy(), status.copy(), made
+        _iterate_discs(flat, order, status, scale, 0.0, k, 0, k, keep)
+        return imp.reshape(n, 2).copy(), status.copy()
 
     # q of U = W s + q: the free local velocity (bias included) of :func:`solve_discs`
     nm = scene.n_mobile

@@ -204,21 +204,3 @@ def test_rest_polyhedron_is_the_equilibrium_set():
     residual = finish.relative_residual(s, (W @ s.ravel() + (Hm.T @ free + problem.bias.ravel())).reshape(-1, 2),
                                         c.mu, 1.0 / W.diagonal()[0::2], mgh)
     assert residual <= 1e-12
-
-
-def test_finish_is_nlgs_where_nlgs_converges():
-    """Where NLGS converges at a steady rate (a step from rest of a dense 300-disc packing)
-    the finishing stage lets NLGS go on and stops it at the tolerance: no projection, the
-    sweeps of plain NLGS to within a residual check (its chunks used to run to their end:
-    on Figure 2's step 19,720 sweeps to 1e-10 against NLGS's 8,720)."""
-    from ncd.studies.bench import dense_packing
-    scene = dense_packing(300)
-    problem = ncd.prepare_step(scene, H)
-    order = np.random.default_rng(3).permutation(problem.contacts.n)
-    for tol in (1e-8, 1e-10):
-        plain, _, _ = ncd.solve_problem(scene, problem, None, order,
-                                        ncd.SolverSettings(tol=tol, max_sweeps=50000, check_every=10))
-        fin, _, _ = ncd.solve_problem(scene, problem, None, order, ncd.SolverSettings(
-            tol=1e-4, max_sweeps=50000, check_every=10, finish="active_set", finish_tol=tol))
-        assert plain.converged and fin.converged and fin.residual <= tol and fin.finish_rounds == 0
-        assert plain.sweeps - 10 <= fin.sweeps <= plain.sweeps + 20, (tol, plain.sweeps, fin.sweeps)
