@@ -26,8 +26,8 @@ review orders; dense packings):
 
 Measured to a residual of 1e-10 from the zero guess, memory 20 (NLGS sweeps, plain
 NLGS's in brackets): fig2's step 620-900 over 6 review orders (8,720-9,070); 10^3-disc
-packing 190-210 (3,440-3,790); 10^4-disc packing 1,110 (29,530).  Wall time 5-8x,
-9-11x and 10.5x shorter: on fig2's step the sweep count falls 10-14x, and the Anderson
+packing 190-210 (3,440-3,790); 10^4-disc packing 1,110 (29,530).  Wall time 5.1-7.5x,
+8.8-9.5x and 10.5-11.9x shorter: on fig2's step the sweep count falls 10-14x, and the Anderson
 steps take the rest.  The pile's final state (Figure 4) is not helped: NLGS and AA
 both stall at residuals ~1e-6 (``finish="active_set"``, :mod:`ncd.finish`, is the route there); AA
 without the safeguard, memory 50 or 100, jumped from ~1e-6 to below 1e-10 in 3 of 12

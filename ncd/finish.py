@@ -40,9 +40,10 @@ capped (:data:`ncd.finish_lp.SIMPLEX_LIMIT`): uncapped, one empty polyhedron kep
 20 s without an answer.  Where NLGS converges at a steady rate (fig2's step, dense
 packings) the stage is NLGS itself, with chunks that run to their end: on fig2's step
 19,720 sweeps to 1e-10 against plain NLGS's 8,720.  Stopping a chunk at the first check
-below ``finish_tol`` was tried and dropped: at 1e-10 grains still moved at up to 8e-9
-g h, above the rest bound, and every run of the reduced pile was no longer at rest; the
-run to the chunk's end takes the residual far below the target (~1e-14).
+below ``finish_tol`` was tried and dropped: stopped at 1e-10, the grains of the
+convergence test's column moved at 8e-9 g h (where that test bounds a finished state by
+1e-9) and no run of the reduced pile passed the rest bound (1e-8 g h); the run to the
+chunk's end takes the residual far below the target (~1e-14).
 
 :func:`check_solution` checks a solution componentwise (cone, complementarity,
 sticking and sliding velocities).  :func:`project_statuses` (the minimum-norm point
