@@ -47,7 +47,9 @@ class SolverSettings:
     statuses it has settled, the active set, until the natural-map residual is <= ``finish_tol``).
     ``observable_tol``: largest relative change of an observed quantity over the
     last residual checks for a run to count as converged (:mod:`ncd.convergence`).
-    ``keep_best``: at ``max_sweeps`` return the iterate of smallest residual seen.
+    ``keep_best``: at ``max_sweeps`` return the iterate of smallest residual seen
+    (``False``: the last sweep's, as LMGC90 and Siconos do; the stability study's
+    setting, since time steps going on from the best iterate made its 10^6 stack gain energy).
     ``accel``: "none" (plain NLGS) or "anderson" (:mod:`ncd.anderson`: Anderson
     acceleration of the sweeps with ``accel_memory`` stored differences, disc form only;
     memory 0 is plain NLGS).

@@ -103,7 +103,7 @@ def status(row):
 def inaccurate(row):
     """Bounded but wrong: a tenth of a radius of interpenetration, tunnelling, or NLGS
     steps stopped at max_sweeps."""
-    return row.stable and (row.max_penetration > 0.1 or row.tunnelled or row.unconverged_steps > 0)
+    return bool(row.stable) and bool(row.max_penetration > 0.1 or row.tunnelled or row.unconverged_steps > 0)
 
 
 colors = {"stable": "tab:green", "energy grows": "tab:orange", "diverged": "tab:red"}
@@ -198,8 +198,14 @@ inacc = cd[[inaccurate(r) for _, r in cd.iterrows()]]
 lines.append(f"* **Bounded is not accurate**: {len(inacc)} stable CD runs penetrate by more than "
              f"0.1 r, tunnel or stop NLGS at max_sweeps (crosses in panel a): "
              + ", ".join(f"{c} h={h:.0e}" for c, h in zip(inacc.case, inacc.h)) + ".")
-lines.append(f"* **Energy never grows for e < 1 in CD**: largest growth "
-             f"{lossy.energy_growth.max():.2g} E_s over {len(lossy)} runs.")
+grew = lossy[lossy.energy_growth > 1e-9]
+if len(grew) == 0:
+    lines.append(f"* **Energy never grows for e < 1 in CD**: largest growth "
+                 f"{lossy.energy_growth.max():.2g} E_s over {len(lossy)} runs.")
+else:
+    lines.append(f"* **Energy grows in {len(grew)} of {len(lossy)} CD runs with e < 1**: "
+                 + ", ".join(f"{c} h={h:.0e}: {g:.2g} E_s ({u} steps unconverged)" for c, h, g, u
+                             in zip(grew.case, grew.h, grew.energy_growth, grew.unconverged_steps)) + ".")
 for case in cases:
     sub_md = md[md.case == case]
     ok = sub_md[sub_md.stable == 1]
@@ -226,8 +232,13 @@ display(Markdown("\n".join(lines)))
 # disc's $\omega$ is $10^3$ times larger than the heavy one's: MD pays this stiffness
 # with $\sim 10^5$–$10^6$ steps.
 #
-# **CD** (verdicts above, measured values in the next cell): the implicit contact law
-# does not inject energy for $e < 1$, and the $e = 1$ cradle keeps its energy (panel d).
+# **CD** (verdicts above, measured values in the next cell): whether the implicit
+# contact law injects energy for $e < 1$ is read from the table (the verdict above), and
+# the $e = 1$ cradle's energy is in panel d.  A step stopped at `max_sweeps` is not a
+# solution: it goes on from the last sweep (`keep_best: false` in the config), as
+# LMGC90 and Siconos do.  Going on instead from the iterate of smallest residual (the
+# default of a single solve, `ncd.SolverSettings.keep_best`) makes the $10^6$ stack gain
+# energy (the config's comment gives the measured gain).
 # **Where CD is not accurate, and why:**
 #
 # 1. *Mass ratio $10^6$: NLGS does not converge.*  For the two contacts of the stack the

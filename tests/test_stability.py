@@ -93,6 +93,31 @@ def test_md_forces_balance_weight_at_rest():
     assert external_force(s, c, f)[1] == pytest.approx(s.mass[0] * 9.81, rel=1e-6)
 
 
+# ------------------------------------------------------------------ unconverged steps
+def test_unconverged_steps_go_on_from_the_last_sweep():
+    """The 10^6 stack at h = 1e-3 (NLGS contracts by 1 - 1e-6 per sweep: every step stops
+    at max_sweeps).  Going on from the last sweep, as the study does (config
+    ``stability.solver.keep_best: false``), gains no energy; going on from the iterate of
+    smallest residual gains a sizeable part of E_s: the reason for the study's setting."""
+    from pathlib import Path
+
+    import yaml
+    from ncd.studies import stability as S
+
+    cfg = yaml.safe_load((Path(__file__).resolve().parent.parent / "config.yaml").read_text())["stability"]
+    assert cfg["solver"]["keep_best"] is False
+    case = cfg["cases"]["stack_1e6"]
+    s_ref, info = S.build("stack", {"md_overlap": cfg["md_overlap"], **case}, cfg["root_seed"])
+    growth = {}
+    for keep_best in (False, True):
+        out = S.run_cd(s_ref.copy(), 1e-3, 200, ncd.SolverSettings(**{**cfg["solver"], "keep_best": keep_best}),
+                       100 * info["v_scale"], 50)
+        assert out["unconverged_steps"] >= 100
+        growth[keep_best] = (max(float(np.max(out["trace"], initial=out["e0"])), out["e_end"]) - out["e0"]) / info["e_scale"]
+    assert growth[False] <= 1e-9
+    assert growth[True] > 0.05
+
+
 # ------------------------------------------------------------------ the stability table
 @pytest.fixture(scope="module")
 def table(results):
@@ -169,10 +194,18 @@ def nlgs(results):
 
 def test_nlgs_tighter_tolerance_never_larger_error(nlgs):
     """Same guess, same order: a tighter tolerance runs at least as many sweeps, stops at a
-    residual below its tolerance and never farther from the limit."""
+    residual below its tolerance and never farther from the limit, to within the
+    reference's own error.  The reference is a run too (residual ``reference_residual``):
+    with the error per unit residual of the residual criterion at its tightest
+    tolerance, its error is about that ratio times its residual (on the default slope
+    ~2e-10 g h, which the finished runs, at residuals ~1e-14, sit at)."""
     assert {"packing28", "pile", "slope"} <= set(nlgs.state.values)
     for state in nlgs.state.values:
         for init in nlgs.init.values:
+            tight = nlgs.sel(state=state, init=init, criterion="residual").sortby("tol").isel(tol=0)
+            ref_res = float(nlgs.reference_residual.sel(state=state, init=init))
+            floor = {key: float(tight[key]) / float(tight.residual) * ref_res
+                     for key in ("error_velocity", "error_impulse")}
             for crit in nlgs.criterion.values:
                 e = nlgs.sel(state=state, init=init, criterion=crit).sortby("tol", ascending=False)
                 assert np.all(np.diff(e.sweeps.values) >= 0), (state, init, crit)
@@ -185,7 +218,7 @@ def test_nlgs_tighter_tolerance_never_larger_error(nlgs):
                     continue
                 for key in ("error_velocity", "error_impulse"):
                     v = e[key].values
-                    assert np.all(v[1:] <= v[:-1] * (1 + 1e-9) + 1e-15), (state, init, crit, key, v)
+                    assert np.all(v[1:] <= v[:-1] * (1 + 1e-9) + floor[key] + 1e-15), (state, init, crit, key, v)
         assert np.all(nlgs.reference_converged.sel(state=state).values == 1)
 
 
