@@ -54,6 +54,13 @@ def _rows(html):
     return len(re.findall(r"<tr[\s>]", html))
 
 
+def _body_rows(html):
+    """Data rows of an HTML table: the rows of its ``<tbody>`` (pandas writes one or
+    two header rows in ``<thead>``), else all rows but the first."""
+    bodies = re.findall(r"<tbody.*?</tbody>", html, flags=re.S)
+    return sum(_rows(b) for b in bodies) if bodies else max(_rows(html) - 1, 0)
+
+
 def fold_long_tables(nb, limit=LONG_TABLE):
     """Wrap every HTML table output with more than ``limit`` rows in a collapsed block."""
     for cell in nb.cells:
@@ -65,7 +72,7 @@ def fold_long_tables(nb, limit=LONG_TABLE):
             html = "".join(html) if isinstance(html, list) else html
             n = _rows(html)
             if "<table" in html and n > limit:
-                data["text/html"] = (f'<details class="ncd-table"><summary>table of {n - 1} rows '
+                data["text/html"] = (f'<details class="ncd-table"><summary>table of {_body_rows(html)} rows '
                                      f"(click to show)</summary>{html}</details>")
                 data.pop("text/plain", None)
     return nb

@@ -18,6 +18,8 @@ import numpy as np
 import xarray as xr
 import yaml
 
+from .convergence import REST
+
 REPRODUCED, DIFFERS, BEYOND, NOT_COMPUTED = "reproduced", "differs", "beyond the paper", "not computed"
 
 
@@ -157,11 +159,14 @@ def fig3_outlines(results):
 
 def fig3_boundary(results):
     rows, _ = _fig3_rows(results)
-    near = {m: np.mean([r["near_boundary"] for r in rows if r["mode"] == m]) for m in ("zero", "uniform")}
-    return Measured(f"points within 5 % of √area of the boundary: NLGS zero guess {_pct(near['zero'])}, "
-                    f"uniform sample of A ∩ C {_pct(near['uniform'])}",
-                    REPRODUCED if near["zero"] > near["uniform"] else DIFFERS,
-                    "NLGS points nearer the boundary than a uniform sample")
+    contacts = sorted({r["contact"] for r in rows})
+    near = {(r["contact"], r["mode"]): r["near_boundary"] for r in rows}
+    denser = [k for k in contacts if near[(k, "zero")] > near[(k, "uniform")]]
+    txt = "; ".join(f"contact {k}: NLGS zero guess {_pct(near[(k, 'zero')])}, uniform {_pct(near[(k, 'uniform')])}"
+                    for k in contacts)
+    return Measured(f"points within 5 % of √area of the boundary — {txt}",
+                    REPRODUCED if len(denser) == len(contacts) else DIFFERS,
+                    "at every displayed contact, NLGS points nearer the boundary than a uniform sample of A ∩ C")
 
 
 def fig3_exact(results):
@@ -190,15 +195,15 @@ def fig4_parallel(results):
 def fig4_cut_vs_cloud(results):
     cuts, ens = _open(results, "fig4_pile/cuts.nc"), _open(results, "fig4_pile/ensemble.nc")
     k, kinds = _default_cut(cuts)
-    conv = ens.converged.values.astype(bool)
-    P = np.column_stack([ens.cut_force_x.values[conv, k], ens.cut_force_y.values[conv, k]])
+    rest = ens.outcome.values == REST       # converged at rest: motion solutions are another outcome
+    P = np.column_stack([ens.cut_force_x.values[rest, k], ens.cut_force_y.values[rest, k]])
     if len(P) < 2:
-        return Measured(f"{len(P)} converged run(s): no cloud", NOT_COMPUTED, "—")
+        return Measured(f"{len(P)} run(s) at rest: no cloud", NOT_COMPUTED, "—")
     diam = float(np.max(np.hypot(*(P[:, None] - P[None]).transpose(2, 0, 1))))
     H = np.column_stack([cuts.history_fx.values, cuts.history_fy.values])
     moves = [float(np.linalg.norm(H[kinds.index(m)] - H[k])) for m in ("minus", "plus") if m in kinds]
     ok = min(moves) > 2 * diam
-    return Measured(f"cloud diameter {diam:.3g} N over {len(P)} converged runs; moving the cut by one diameter "
+    return Measured(f"cloud diameter {diam:.3g} N over the {len(P)} runs at rest; moving the cut by one diameter "
                     f"changes the resultant by {' and '.join(f'{m:.3g}' for m in moves)} N",
                     REPRODUCED if ok else DIFFERS, "change of the resultant more than twice the cloud's diameter")
 
@@ -212,14 +217,20 @@ def fig4_contacts(results):
 
 
 def fig4_dip(results):
-    cuts = _open(results, "fig4_pile/cuts.nc")
-    p, x = cuts.history_pressure.values, 0.5 * (cuts.bin_lo.values + cuts.bin_hi.values)
-    apex = float(cuts.x_profile.values[np.nanargmax(cuts.height.values)])
-    i = int(np.argmin(np.abs(x - apex)))
-    flank = max(p[max(i - 3, 0):i].max(initial=0), p[i + 1:i + 4].max(initial=0))
-    dip = p[i] < flank
-    return Measured(f"history forces: {p[i]:.3g} N/m under the apex, up to {flank:.3g} N/m within three bins",
-                    REPRODUCED if dip else DIFFERS, "ground pressure under the apex below its neighbours'")
+    """The verdict of the fig4_pile page (:func:`ncd.figures.pressure.dip_verdict`): a dip is
+    called only when the history's depth exceeds the spread over analysis choices and the
+    exact range over A ∩ C forces it."""
+    ex = _open(results, "fig4_pile/exact.nc")
+    a = ex.attrs
+    m = [str(c) for c in ex.choice.values].index(a["dip_main_choice"])
+    depth, lo, hi = (float(ex[v].values[m]) for v in ("depth_history", "depth_min", "depth_max"))
+    called = bool(a["dip_called"])
+    return Measured(f"history forces ({a['dip_main_choice']}): dip depth {depth:.3g} N/m, spread over the "
+                    f"analysis choices {float(a['dip_binning_spread']):.3g} N/m, exact range over A ∩ C "
+                    f"[{lo:.3g}, {hi:.3g}] N/m: a dip {a['dip_geometry']} by the geometry, "
+                    f"{'called' if called else 'not called'}",
+                    REPRODUCED if called else DIFFERS,
+                    "a dip (depth < 0) beyond the analysis-choice spread, forced by the geometry")
 
 
 def _history_analysis(results):
@@ -238,7 +249,7 @@ def fig4_history_dip(results):
     return Measured(f"dip of the mean profile over {an.sizes['pile']} point-source piles {float(p.dip_mean):.3f} "
                     f"[{lo:.3f}, {hi:.3f}] (rain {float(r.dip_mean):.3f}; difference p = {float(s.dip_diff_p):.2g})",
                     REPRODUCED if lo > 0 else DIFFERS,
-                    "95 % bootstrap band over piles of the point-source dip depth above 0")
+                    "95 % basic bootstrap band over piles of the point-source dip depth above 0")
 
 
 def fig4_history_arching(results):
@@ -265,8 +276,11 @@ def fig5_governing_flows(results):
 def fig5_governing_line(results):
     from .figures.governing_summary import line_counts
     c = line_counts(_open(results, "fig5_governing/flows.nc"))
+    tc = c["tested"]
     return Measured(f"{c['steps']} indeterminate steps: grain cloud a line at {c['rank'][1]}, an area at "
-                    f"{c['rank'][2]}; one-degree-of-freedom cluster hypothesis holds at {c['holds']}", BEYOND,
+                    f"{c['rank'][2]}; one-degree-of-freedom cluster hypothesis holds at {tc['holds']} of the "
+                    f"{tc['steps']} steps with three solutions or more ({tc['line_and_predicted']} predicted "
+                    f"lines; at two solutions a line is unavoidable)", BEYOND,
                     "cloud rank against the rank of the solutions over the grain's cluster")
 
 

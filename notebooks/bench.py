@@ -93,7 +93,7 @@ start = {k[8:]: v for k, v in core.attrs.items() if k.startswith("startup_")}
 display(Markdown(
     f"Sweep: **{tab.ns_per_update.min():.1f}–{tab.ns_per_update.max():.1f} ns** per contact update "
     f"(C: {tab.ns_per_update_c.min():.1f}–{tab.ns_per_update_c.max():.1f} ns; numba/C "
-    f"{tab.ratio.min():.2f}–{tab.ratio.max():.2f}; the issue's target is 12 ns).  Time per step per "
+    f"{tab.ratio.min():.2f}–{tab.ratio.max():.2f}; the target set for this benchmark is 12 ns).  Time per step per "
     f"disc: {tab.step_us_per_disc.min():.1f}–{tab.step_us_per_disc.max():.1f} µs at a budget of "
     f"{yaml.safe_load(core.attrs['config_yaml'])['step_sweeps']} sweeps.  A fresh interpreter with a warm numba cache imports ncd in "
     f"{start['import_s']:.2f} s and makes its first step {start['first_step_s']:.2f} s later "

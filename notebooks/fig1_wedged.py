@@ -325,8 +325,8 @@ display(Image(filename=str(out_png)))
 # and the final wedging intensity against the initial guess.  Within a sweep the contact
 # reviewed first is solved with the other contact's guessed impulse frozen, so its own
 # guess is overwritten at once: the outcome is set by the guess at the contact reviewed
-# second.  Wall time is a measurement on a shared machine: a run of ordinary sweep count
-# but unusual duration was interrupted, not slow.
+# second.  Wall time is a measurement on a shared machine (other jobs share its two
+# cores); the sweep count is the reproducible cost.
 
 # %%
 fig, axs = plt.subplots(1, 3, figsize=(13, 3.8), constrained_layout=True)

@@ -275,8 +275,8 @@ plt.show()
 # %% [markdown]
 # ## What we measured, and where the reproduction differs
 #
-# The text below is written from this run's data when the notebook runs; the claims
-# of the issue are checked by `tests/test_fig3_equilibrium.py`.
+# The text below is written from this run's data when the notebook runs; its claims
+# are checked by `tests/test_fig3_equilibrium.py`.
 
 # %%
 pa = proj.attrs
@@ -300,9 +300,8 @@ Markdown(f"""
   $\\le$ {ens.attrs['solver_tol']:g}): {', '.join(f'{m} {n_conv[m]}/{subsets[m].sizes["run"]}' for m in modes)};
   median sweeps {', '.join(f'{m} {np.median(subsets[m].sweeps.values):.0f}' for m in modes)}. The converged points
   satisfy equilibrium to {np.max(eq_res):.0e} and Coulomb's law to {np.max(coulomb):.0e} of the largest weight,
-  and lie within {outside / P.scale:.0e} weights of their exact polygons. NLGS converges linearly here (left
-  panel of the convergence plot), so the spread of the clouds is indeterminacy of the equilibrium forces, not
-  unfinished iterations.
+  and lie within {outside / P.scale:.0e} weights of their exact polygons, so every point of the clouds is an
+  admissible force state: their spread is indeterminacy of the equilibrium forces, not unfinished iterations.
 * **Zero guess with random orders (the paper's figure).** Its clouds cover
   {', '.join(f'{c:.1%}' for c in cov['zero'])} of the exact projections of the displayed contacts
   ({', '.join(str(k) for k in shown)}): the $(\\kappa - 1)!$ review orders reach limits close to each other.

@@ -15,7 +15,7 @@
 # ---
 
 # %% [markdown]
-# # Figure 4, history as statistics: piles from a point source and from a rain (issue 16)
+# # Figure 4, history as statistics: piles from a point source and from a rain
 #
 # **What the paper says (section 5).** Measurements on sand piles poured from a
 # localized source show a ground-pressure minimum under the apex; the messages from
@@ -96,15 +96,15 @@ its edges on average, so the rained piles hold {R['grains_min']} to {R['grains_m
 each pile's own weight). The rained deposits are {R['apex']:.1f} d high with fitted flanks of
 {R['slope']:.1f}° (apex / ($L$ tan flank) = {R['cone']:.2f}):
 {'a flat layer over the base with steep edges, not a heap with flanks at the angle of repose' if R['slope'] < 0.5 * P['slope'] else 'heaps'}.
-Grains rained gently (perfectly inelastic impacts, drop height {cfg['source']['drop_height_d']:g} d)
-stop where they land; a layer's edge of a few grains stands steeper than the flanks of a
-pile built by avalanches, so few grains roll off. The experiments' rain falls from higher,
-with bouncing grains; much faster impacts need a smaller time step here (the grains then
-overlap by more than the overlap tolerance within one step).
+The grains are rained gently (perfectly inelastic impacts, drop height
+{cfg['source']['drop_height_d']:g} d); the experiments' rain falls from higher, with bouncing
+grains. Much faster impacts need a smaller time step here (the grains then overlap by more
+than the overlap tolerance within one step); why the gentle rain builds a layer rather than
+a heap was not studied.
 Both histories are drawn against $x / L$ with the $L$ of the member's point-source pile.
 
 **Ground stress ({s['piles']} piles per history, kernel {k:g} d).** Dip depth of the
-mean profile: point source {P['dip']:.3f} (95 % band {P['lo']:.3f} to {P['hi']:.3f}),
+mean profile: point source {P['dip']:.3f} (95 % basic bootstrap band over piles {P['lo']:.3f} to {P['hi']:.3f}),
 rain {R['dip']:.3f} ({R['lo']:.3f} to {R['hi']:.3f}); {100 * P['frac_dip']:.0f} % of the
 point-source piles and {100 * R['frac_dip']:.0f} % of the rained piles have a dip of
 their own. The difference point − rain is {s['diff']:.3f} (band {s['diff_lo']:.3f} to
@@ -122,12 +122,14 @@ times the mean stress W / 2L.
 **Against the experiments.** Vanel et al. (1999) and Geng et al. (2001) report a dip
 under point-source piles and a central maximum under rained piles. Here the
 point-source dip is {'resolved (its band excludes 0)' if P['lo'] > 0 else 'not resolved (its band includes 0 or is negative)'},
-and the rained deposit has {'a hump (negative dip, band below 0)' if R['hi'] < 0 else 'no resolved hump'}.
+and the rained deposit has {'a hump (negative dip, band below 0)' if R['hi'] < 0 else ('a resolved dip (band above 0), the opposite of the central maximum of the experiments' if R['lo'] > 0 else 'neither a resolved hump nor a resolved dip (band includes 0)')}.
 
 **Arching.** Over all cuts and piles the resultant is on median {P['dev_median']:.1f}° (point)
 and {R['dev_median']:.1f}° (rain) steeper than the flank (interquartile range
 {P['dev_iqr']:.1f}° and {R['dev_iqr']:.1f}°); it is steeper than the free surface at
-{100 * P['arching']:.0f} % and {100 * R['arching']:.0f} % of the cuts.
+{100 * P['arching']:.0f} % and {100 * R['arching']:.0f} % of the cuts. (Arching here means a
+resultant steeper than the flank; the exact test of `fig4_pile` uses a weaker one, a
+resultant that pushes the bank downward, $F_y < 0$.)
 """))
 
 # %% [markdown]

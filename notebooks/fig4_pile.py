@@ -417,6 +417,8 @@ plt.show()
 mid = scan & (np.abs(cuts.cut_x.values) > 0.25 * np.where(cuts.outer.values < 0, abs(a["left_toe"]), a["right_toe"])) \
     & (np.abs(cuts.cut_x.values) < 0.75 * np.where(cuts.outer.values < 0, abs(a["left_toe"]), a["right_toe"]))
 dev_mid = cuts.history_deviation.values[mid]
+dev_left = cuts.history_deviation.values[mid & (cuts.outer.values < 0)]
+dev_right = cuts.history_deviation.values[mid & (cuts.outer.values > 0)]
 Fmean = np.linalg.norm(P.mean(0)) if len(P) else np.nan
 clouds = [r[4] for r in rows]
 j_ens = int(np.argmin(np.abs(np.log(tol.tol.values / float(ens.tol)))))   # the study's row at the ensemble's tol
@@ -490,12 +492,13 @@ Markdown(f"""
   grains under it, `config.yaml`) rather than fixed: the largest interpenetration during the construction is
   {float(con.max_penetration.max()) / d:.3f} d.
 * **Angle of repose.** {a['left_angle']:.1f}° (left flank) and {a['right_angle']:.1f}° (right flank), with
-  $\\mu$ = {cfg['mu']:g} (config): discs roll, so a 2-D pile of discs stands lower than sand.
+  $\\mu$ = {cfg['mu']:g} (config).
 * **Arching.** The history resultant across the default cut ({int(cuts.n_crossing[K])} contacts) points
   {float(cuts.history_angle[K]):.0f}° below the horizontal, {float(cuts.history_deviation[K]):+.0f}° from the free
   surface's slope. Across the scan, the deviation from the slope has a median of {stat(np.median, dev_mid):+.1f}°
-  over the middle half of the flanks ({int(mid.sum())} cuts, {stat(np.median, cuts.n_crossing.values[mid]):.0f}
-  contacts each), and single cuts scatter by ±{stat(np.std, dev_mid):.0f}° (std, panel c); the cuts moved by
+  over the middle half of the flanks ({int(mid.sum())} cuts, a median of {stat(np.median, cuts.n_crossing.values[mid]):.0f}
+  contacts each), and single cuts scatter by ±{stat(np.std, dev_left):.0f}° (left flank) and
+  ±{stat(np.std, dev_right):.0f}° (right flank; standard deviations, panel c); the cuts moved by
   ±{cfg['cut']['shift_d']:g} d deviate by {float(cuts.history_deviation[KM]):+.0f}° and
   {float(cuts.history_deviation[KP]):+.0f}°.
 * **The cloud.** {cloud_text}

@@ -43,7 +43,7 @@
 # The two are different statistics of the same set: $\eta_\mathrm{exact}$ is its full
 # extent along each contact, $\eta_U$ the distance a short random walk travels in it.
 #
-# **Flows across parameters** (items 2 and 3 of issue 15). Figure 2's flow (the discs of
+# **Flows across parameters.** Figure 2's flow (the discs of
 # `fig2_slope.scene` on its rough periodic ground) is released at several friction
 # coefficients, time steps and slope angles, one factor at a time around Figure 2's
 # setting, several flows (seeds) per setting. Every setting of a seed is released from the
@@ -155,7 +155,9 @@ display(Markdown(
     f"{cfg['unger']['rounds']} noise-and-relax rounds travel only part of it (median ratio printed above). "
     f"Built-in differences: a body-force load (stress growing with depth) instead of a lid, the whole "
     f"packing instead of a bulk slice with fixed boundary forces, and {int(te[:, 3].min())}–{int(te[:, 3].max())} "
-    f"packings per μ in this run."))
+    f"packings per μ in this run"
+    + (f"; with fewer than 3 packings at some μ the location of the largest mean is not resolved "
+       f"(the seed bands of the figure)." if int(te[:, 3].min()) < 3 else ".")))
 
 # %% [markdown]
 # ## Flows: indeterminate steps against friction, time step and slope
@@ -211,7 +213,11 @@ display(Markdown(
     f"one-degree-of-freedom cluster decides between the solutions — holds at {c['holds']} of "
     f"{c['steps']} steps ({c['line_and_predicted']} lines predicted, {c['line_not_predicted']} lines "
     f"not predicted). Two solutions always span one direction: with two exact solutions the line is "
-    f"unavoidable, and the test has content only at the steps with three or more. Keeping the statuses "
+    f"unavoidable, and the test has content only at the {c['tested']['steps']} steps with three or more. "
+    f"There it holds at {c['tested']['holds']}: {c['tested']['line_and_predicted']} predicted lines and "
+    f"{c['tested']['neither']} steps with neither a line nor a prediction; it fails at "
+    f"{c['tested']['line_not_predicted']} lines not predicted and {c['tested']['predicted_not_line']} "
+    f"predicted lines that are not. Keeping the statuses "
     f"of the most frequent solution leaves grain velocities free (a continuum of solutions) at "
     f"{c['continuum']} steps; elsewhere the solutions are isolated points and the impulses alone are "
     f"indeterminate (median dimension {np.nanmedian(flows.null_impulse.values[flows.indeterminate.values == 1]) if c['steps'] else np.nan:.0f})."))

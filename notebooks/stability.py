@@ -235,8 +235,7 @@ display(Markdown("\n".join(lines)))
 # **CD** (verdicts above, measured values in the next cell): whether the implicit
 # contact law injects energy for $e < 1$ is read from the table (the verdict above), and
 # the $e = 1$ cradle's energy is in panel d.  A step stopped at `max_sweeps` is not a
-# solution: it goes on from the last sweep (`keep_best: false` in the config), as
-# LMGC90 and Siconos do.  Going on instead from the iterate of smallest residual (the
+# solution: it goes on from the last sweep (`keep_best: false` in the config).  Going on instead from the iterate of smallest residual (the
 # default of a single solve, `ncd.SolverSettings.keep_best`) makes the $10^6$ stack gain
 # energy (the config's comment gives the measured gain).
 # **Where CD is not accurate, and why:**
@@ -246,7 +245,8 @@ display(Markdown("\n".join(lines)))
 #    = 1 - 10^{-6}$ per sweep, so no sweep budget reaches the tolerance: steps
 #    stop at `max_sweeps`, the impulses are too small
 #    and the heavy disc sinks into the light one.  At $1:10^3$ the contraction is
-#    $1 - 10^{-3}$ and the warm start keeps up.  MD, at its tiny step, is accurate here.
+#    $1 - 10^{-3}$ per sweep: the next cell counts the steps that still stop at the budget.
+#    MD, at its tiny step, is accurate here.
 # 2. *Large $h$: interpenetration $\approx v h$.*  CD does not correct positions: a
 #    contact becomes active only once its gap at the middle configuration is closed,
 #    so an approaching disc penetrates by up to its displacement per step.  When a
@@ -255,24 +255,19 @@ display(Markdown("\n".join(lines)))
 #    stays negative behind it), but the disc ends up beyond the wall line.
 # 3. *Very large $h$ on a packing at rest: active-set flicker.*  With the default slack
 #    ($10^{-9}r$) a contact whose gap opens by the NLGS residual velocity times $h/2$
-#    (here $\sim 10^{-8}\,g h \cdot h$) leaves the active set for a whole step and its
+#    leaves the active set for a whole step and its
 #    disc falls freely by $g h^2$ — the packing can collapse through itself although
-#    every step "converged".  A tighter tolerance or an alert distance (case
-#    `hexagonal_alert`, larger slack) removes it.
+#    every step "converged".  An alert distance (case `hexagonal_alert`, larger slack)
+#    is the remedy run here; the next cell gives both cases.
 # 4. *$\mu = 10$: NLGS may cycle.*  On some steps the iterates of the falling box
 #    can settle into a cycle (one contact flips between sliding and open) and the residual
-#    stall whatever the sweep budget, review order or initial guess; the motion stays
-#    bounded and dissipative, but those steps are not solutions.
+#    stall at the sweep budget; such steps are not solutions.  The next cell says whether
+#    this run met any.
 # 5. *$e = 1$ chain: energy kept, but not Newton's cradle.*  Moreau's impact law on the
 #    weighted mean $(U_f + eU_i)/(1+e)$ treats the touching chain as one simultaneous
 #    multi-contact collision: energy is conserved, yet the striker's momentum is shared
 #    (the last disc leaves at a fraction of the striker's speed, the striker bounces back)
-#    instead of passing through the chain as a sequence of binary collisions.  The
-#    Every step of this case converges in a few sweeps.  An earlier version flagged its
-#    steps after the impact as unconverged: the projection on the Coulomb cone returned
-#    $(z_n < 0, 0)$ unchanged when $\mu = 0$, so a separating frictionless contact with
-#    zero impulse read as unsolved (fixed in `ncd.local_solver.project_cone`, checked by
-#    `tests/test_mechanics.py`).
+#    instead of passing through the chain as a sequence of binary collisions.
 
 # %%
 # the numbers of the five points above, from this run's table
@@ -286,6 +281,11 @@ if len(s6):
     pts.append(f"1. `stack_1e6`: {int(s6.unconverged_steps.sum())} CD steps stopped at `max_sweeps` (largest residual "
                f"{s6.residual_max.max():.1e}); interpenetration / r " + ", ".join(
                    f"{p:.2g} at h = {h:.0e}" for h, p in zip(s6.h, s6.max_penetration)) + ".")
+s3 = case_rows("stack_1e3")
+if len(s3):
+    pts.append(f"   `stack_1e3`: {int(s3.unconverged_steps.sum())} CD steps stopped at `max_sweeps` (largest residual "
+               f"{s3.residual_max.max():.1e}, tolerance {ds.attrs['solver_tol']:g}); interpenetration / r " + ", ".join(
+                   f"{p:.2g} at h = {h:.0e}" for h, p in zip(s3.h, s3.max_penetration)) + ".")
 imp = pd.concat([case_rows(c) for c in ("impact_wall", "impact_disc")] + [case_rows("mu0")])
 if len(imp):
     tun = imp[imp.tunnelled == 1]
@@ -307,6 +307,7 @@ if len(m10):
                + ("." if m10.unconverged_steps.sum() else ": no cycling in this run."))
 ch = case_rows("e1_chain")
 if len(ch):
-    pts.append(f"5. `e1_chain` (CD): energy drift at most {ch.energy_drift.abs().max():.1g} E_s; the last disc leaves "
+    pts.append(f"5. `e1_chain` (CD): {int(ch.unconverged_steps.sum())} steps unconverged; energy drift at most "
+               f"{ch.energy_drift.abs().max():.1g} E_s; the last disc leaves "
                f"at {ch.observable.min():.2g}–{ch.observable.max():.2g} of the striker's speed (1 for Newton's cradle).")
 display(Markdown("**Measured in this run.**\n\n" + "\n".join(pts)))

@@ -99,3 +99,23 @@ def test_figure_pages_in_chromium(results, figure):
     if not page.exists():
         pytest.skip(f"{figure} not built in this run")
     check_in_browser(page, results / "screenshots" / f"{figure}.png")
+
+
+def test_folded_table_counts_data_rows_only():
+    """A long table is folded with its count of data rows, whatever its header rows (a
+    two-level column index writes two)."""
+    import numpy as np
+    import pandas as pd
+
+    from ncd.render import fold_long_tables
+
+    n = LONG_TABLE + 5
+    flat = pd.DataFrame({"a": np.arange(n), "b": np.arange(n)})
+    two = pd.DataFrame(np.zeros((n, 2)), columns=pd.MultiIndex.from_tuples([("x", "p"), ("x", "q")]))
+    for df in (flat, two):
+        nb = nbformat.v4.new_notebook()
+        cell = nbformat.v4.new_code_cell("df")
+        cell.outputs = [nbformat.v4.new_output("execute_result", data={"text/html": df.to_html()}, execution_count=1)]
+        nb.cells = [cell]
+        html = fold_long_tables(nb).cells[0].outputs[0]["data"]["text/html"]
+        assert f"table of {n} rows" in html, re.search(r"table of \d+ rows", html)

@@ -59,12 +59,21 @@ def line_counts(ds):
     0, 1, 2), ``predicted`` (cluster with one degree of freedom), ``holds`` (hypothesis
     agrees with the cloud), ``line_and_predicted`` / ``line_not_predicted``,
     ``solutions`` (number of exact solutions: 2, 3, more), ``continuum`` (a solution's
-    statuses leave grain velocities free: null_velocity > 0), ``one_cluster``."""
+    statuses leave grain velocities free: null_velocity > 0), ``one_cluster``; and
+    ``tested``: the same over the steps with three solutions or more, the only ones where
+    the hypothesis can fail (two solutions always span one direction): ``steps``,
+    ``holds``, ``line_and_predicted``, ``line_not_predicted``, ``predicted_not_line``,
+    ``neither`` (no line, none predicted)."""
     ind = ds.indeterminate.values == 1
     rank = ds.cloud_rank.values[ind]
     pred = ds.predicted_line.values[ind] == 1
     line = rank == 1
     nex = ds.n_exact.values[ind]
+    holds = ds.hypothesis_holds.values[ind] == 1
+    k = nex >= 3
+    tested = {"steps": int(k.sum()), "holds": int((holds & k).sum()),
+              "line_and_predicted": int((line & pred & k).sum()), "line_not_predicted": int((line & ~pred & k).sum()),
+              "predicted_not_line": int((~line & pred & k).sum()), "neither": int((~line & ~pred & k).sum())}
     return {"steps": int(ind.sum()), "rank": [int((rank == r).sum()) for r in (0, 1, 2)],
             "predicted": int(pred.sum()), "holds": int((ds.hypothesis_holds.values[ind] == 1).sum()),
             "line_and_predicted": int((line & pred).sum()), "line_not_predicted": int((line & ~pred).sum()),
@@ -72,7 +81,8 @@ def line_counts(ds):
             "continuum": int((ds.null_velocity.values[ind] > 0).sum()),
             "one_cluster": int((ds.n_clusters.values[ind] == 1).sum()),
             "switched_median": float(np.median(ds.n_switched.values[ind])) if ind.any() else np.nan,
-            "moving_median": float(np.median(ds.n_moving.values[ind])) if ind.any() else np.nan}
+            "moving_median": float(np.median(ds.n_moving.values[ind])) if ind.any() else np.nan,
+            "tested": tested}
 
 
 __all__ = ["FACTOR_VAR", "flow_measures", "factor_table", "line_counts"]

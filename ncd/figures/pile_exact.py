@@ -243,7 +243,7 @@ def exact_text(exact, ens, cuts):
                  f"certified to {np.nanmax(exact.angle_bound.values):.0e}°; on the three polygons the ranges agree "
                  f"with the polygons' own to {a['polygon_angle_gap']:.0e}°).")
     m = list(exact.choice.values).index(a["dip_main_choice"])
-    lines.append(f"Ground pressure ({a['dip_main_choice']} kernel): dip depth p(0) - (p(-a)+p(a))/2 with "
+    lines.append(f"Ground pressure ({a['dip_main_choice']}): dip depth p(0) - (p(-a)+p(a))/2 with "
                  f"a = {a['dip_offset'] * 1e3:.1f} mm is {float(exact.depth_history[m]):.1f} N/m for the history "
                  f"forces; over the analysis choices it spans {a['dip_binning_spread']:.1f} N/m; over A ∩ C it "
                  f"ranges exactly from {float(exact.depth_min[m]):.1f} to {float(exact.depth_max[m]):.1f} N/m: a dip "
