@@ -492,5 +492,6 @@ Markdown(f"""
   them. Its figure shows a line of many points; at {tight:.0e} our zero-guess runs sit on
   {len(cloud['visited'])} exact solution(s) of the census, within {cloud['max_offset'] / g:.1e} $g$, and spread
   along a filled cloud only when stopped at a loose tolerance ({float(zero_l.spread) / g:.2g} $g$ at {loose:.0e}):
-  points *inside* a line, if any, are runs stopped before convergence.
+  at this step, points between the solutions are runs stopped before convergence. One step is one sample; the
+  scan above and `fig5_governing` (flows across parameters) count the steps with several solutions.
 """)
