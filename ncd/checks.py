@@ -110,6 +110,33 @@ def array(name, value, shape, finite=True, dtype=float):
     return arr
 
 
+def sparse_matrix(name, M, shape=None):
+    """A scipy.sparse ``M`` as a CSR float matrix, its *structure* checked before anything
+    reads it: indices within the shape, ``indptr`` monotone and consistent (a CSR or CSC
+    with an index out of range, e.g. 1-based, segfaults a sparse product or corrupts the
+    heap when converted), real and finite entries, ``shape`` when given."""
+    if M.dtype.kind not in "iuf":
+        raise InputError(f"{name} must hold real numbers; got dtype {M.dtype}")
+    fmt = M.format
+    try:
+        if fmt in ("csr", "csc", "bsr"):
+            M.check_format(full_check=True)
+        elif fmt == "coo":
+            rows, cols = np.asarray(M.row), np.asarray(M.col)
+            for what, idx, size in (("row", rows, M.shape[0]), ("column", cols, M.shape[1])):
+                if idx.size and (idx.dtype.kind not in "iu" or idx.min() < 0 or idx.max() >= size):
+                    raise ValueError(f"{what} index out of range [0, {size})")
+    except (ValueError, TypeError, IndexError, OverflowError) as exc:
+        raise InputError(f"{name} ({fmt}, shape {M.shape}) has an invalid structure: {exc}") from None
+    out = sp.csr_matrix(M, dtype=float)
+    out.sum_duplicates()
+    if shape is not None and out.shape != tuple(shape):
+        raise InputError(f"{name} has shape {out.shape}, expected {tuple(shape)}")
+    if not np.isfinite(out.data).all():
+        raise InputError(f"{name} must be finite; it holds {out.data[~np.isfinite(out.data)][0]!r}")
+    return out
+
+
 def per_item(name, value, n, lo=-np.inf, hi=np.inf, lo_open=False):
     """A scalar broadcast to ``(n,)`` or an ``(n,)`` array, finite, in ``[lo, hi]``."""
     arr = array(name, value, () if len(shape_of(name, value)) == 0 else (n,))
@@ -172,6 +199,9 @@ def settings_arg(settings, name="settings"):
     return settings
 
 
+MAX_SWEEPS = 10 ** 9      # sweep budget at most (hours of NLGS on any scene here; the kernels count in int64)
+
+
 def solver_settings(settings, name="settings"):
     """Field checks of :class:`ncd.SolverSettings` (called by its ``__post_init__``)."""
     from .nlgs import CRITERIA, SolverSettings
@@ -180,8 +210,8 @@ def solver_settings(settings, name="settings"):
     # stored as plain float / int (frozen dataclass: object.__setattr__), so that later
     # checks, kernels and netCDF attributes see one type whatever the caller passed
     object.__setattr__(settings, "tol", real(f"{name}.tol", settings.tol, 0.0, lo_open=True))
-    object.__setattr__(settings, "max_sweeps", integer(f"{name}.max_sweeps", settings.max_sweeps, 1))
-    object.__setattr__(settings, "check_every", integer(f"{name}.check_every", settings.check_every, 1))
+    object.__setattr__(settings, "max_sweeps", integer(f"{name}.max_sweeps", settings.max_sweeps, 1, MAX_SWEEPS))
+    object.__setattr__(settings, "check_every", integer(f"{name}.check_every", settings.check_every, 1, MAX_SWEEPS))
     if not isinstance(settings.criterion, str) or settings.criterion not in CRITERIA:
         raise InputError(f"{name}.criterion = {settings.criterion!r} must be one of {sorted(CRITERIA)}")
     from . import nlgs
@@ -220,14 +250,9 @@ def local_problem(W, q, mu, guess, review_order, settings):
         raise InputError(f"q has length {len(q)}, expected 2 n (rows n_1, t_1, n_2, ...)")
     n = len(q) // 2
     if sp.issparse(W):
-        if W.dtype.kind not in "iuf":
-            raise InputError(f"W must hold real numbers; got dtype {W.dtype}")
-        Wc = sp.csr_matrix(W, dtype=float)
-        Wc.sum_duplicates()
+        Wc = sparse_matrix("W", W)
         if Wc.shape != (2 * n, 2 * n):
             raise InputError(f"W has shape {Wc.shape}, q has length {len(q)}: expected (2n, 2n) and 2n")
-        if not np.isfinite(Wc.data).all():
-            raise InputError(f"W must be finite; it holds {Wc.data[~np.isfinite(Wc.data)][0]!r}")
     else:
         shape = shape_of("W", W)
         if shape != (2 * n, 2 * n):

@@ -5,6 +5,8 @@ The scene and contact checks have a fast path (type and shape tests, then one
 numba pass over the values, a few microseconds) since every step calls them;
 when it fails, the slow path names the argument and the offending value.
 """
+import numbers
+
 import numpy as np
 
 from ._cache import njit
@@ -24,6 +26,12 @@ def scene(s, name="scene", state=False):
         raise InputError(f"{name} must be an ncd.Scene (build it with ncd.make_scene); got {type(s).__name__}")
     if not _scene_ok(s):
         _scene_slow(s, name)
+    t = s.time
+    if isinstance(t, (bool, np.bool_)) or not isinstance(t, numbers.Real) or not np.isfinite(t):
+        raise InputError(f"{name}.time = {_show(t)} must be a finite real number")
+    if s.period > 0 and s.period < 3 * 2 * float(s.radius.max()):
+        raise InputError(f"{name}.period = {s.period} must be 0 (not periodic) or at least three largest "
+                         f"diameters ({6 * float(s.radius.max())})")
     if state and not all(np.isfinite(getattr(s, f)).all() for f in ("pos", "vel", "spin", "angle")):
         raise SimulationError(f"{name} state (pos, vel, spin, angle) is non-finite at t = {s.time}")
     return s

@@ -60,6 +60,8 @@ def nonfinite(config, path=()):
             yield from nonfinite(v, path + (i,))
     elif isinstance(config, float) and not math.isfinite(config):
         yield path, config
+    elif isinstance(config, int) and not isinstance(config, bool) and abs(config) > 1e308:
+        yield path, f"an integer of {len(str(abs(config)))} digits"
 
 
 def _validator(schema):
@@ -69,7 +71,7 @@ def _validator(schema):
 
     checker = Draft202012Validator.TYPE_CHECKER.redefine_many({
         "integer": lambda _, x: isinstance(x, int) and not isinstance(x, bool),
-        "number": lambda _, x: _is_number(x) and math.isfinite(x),
+        "number": lambda _, x: _is_number(x) and (abs(x) <= 1e308 if isinstance(x, int) else math.isfinite(x)),
     })
     cls = validators.extend(Draft202012Validator, type_checker=checker)
     return cls(schema)
@@ -151,6 +153,17 @@ def check_config(config, sections, schema_dir):
     """Check ``config`` for the figures ``sections`` (each needs its config section and
     ``<schema_dir>/<section>.schema.yaml``); other sections present are checked too when
     they have a schema.  Raises :class:`ConfigError` listing every problem found."""
+    if not isinstance(config, dict):
+        raise ConfigError(f"the configuration must be a mapping of sections; got {type(config).__name__}")
+    if not Path(schema_dir).is_dir():
+        raise ConfigError(f"schema_dir = {str(schema_dir)!r} is not a directory of <section>.schema.yaml files")
+    try:
+        _check(config, sections, schema_dir)
+    except RecursionError:
+        raise ConfigError("the configuration nests too deeply (or refers to itself)") from None
+
+
+def _check(config, sections, schema_dir):
     errors = []
     missing = [s for s in sections if s not in config]
     for s in missing:
@@ -161,7 +174,10 @@ def check_config(config, sections, schema_dir):
         errors.append(f"{_name(path)} = {value}: not a finite number")
     for section in config:
         schema = Path(schema_dir) / f"{section}.schema.yaml"
-        if not schema.exists() or not isinstance(config[section], dict):
+        if not schema.exists():
+            continue
+        if not isinstance(config[section], dict):
+            errors.append(f"config section '{section}' must be a mapping of keys; got {_fmt(config[section])}")
             continue
         errors += _schema_errors(section, config[section], schema, skip=bad)
         errors += cross_field_errors(section, config[section])

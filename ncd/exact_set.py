@@ -19,10 +19,22 @@ import highspy
 import numpy as np
 import scipy.sparse as sp
 
+from . import checks
 from .polygon import outside_distance, support_polygon
 from .polytope import ForcePolytope, PolytopeError
 
 FEAS_TOL = 1e-10
+
+
+def _linear_map(name, L, rows, n):
+    """``L`` (dense or sparse) as CSR of shape ``(rows, n)`` (``rows`` None: any), finite."""
+    if sp.issparse(L):
+        L = checks.sparse_matrix(name, L)
+    else:
+        L = sp.csr_matrix(checks.array(name, L, (rows, n)))
+    if (rows is not None and L.shape[0] != rows) or L.shape[1] != n:
+        raise checks.InputError(f"{name} has shape {L.shape}, expected ({'any' if rows is None else rows}, {n})")
+    return L
 
 
 class ExactSet:
@@ -41,8 +53,9 @@ class ExactSet:
 
     def minimize(self, c):
         """``(min c . r, r)`` over A ∩ C (``c`` in force units, ``r`` forces)."""
+        c = checks.array("c", c, (self.n,))
         t0 = time.perf_counter()
-        self.highs.changeColsCost(self.n, self._cols, self._Tt @ np.asarray(c, dtype=float) * self.scale)
+        self.highs.changeColsCost(self.n, self._cols, self._Tt @ c * self.scale)
         self.highs.run()
         status = self.highs.getModelStatus()
         self.n_lp += 1
@@ -78,7 +91,7 @@ class ExactSet:
 
         All minima first, then all maxima, in row order: neighbouring rows (a
         pressure profile) have neighbouring optima, so each LP restarts close by."""
-        rows = sp.csr_matrix(rows)
+        rows = _linear_map("rows", rows, None, self.n)
         out = np.empty((rows.shape[0], 2))
         for j, sign in ((0, 1.0), (1, -1.0)):
             for i in range(rows.shape[0]):
@@ -95,7 +108,8 @@ class ExactSet:
         of all supporting half-planes), ``n_lp``, ``exact`` and ``points`` (the
         support points' full force vectors, one per LP).
         """
-        L = sp.csr_matrix(L)
+        L = _linear_map("L", L, 2, self.n)
+        n_dirs = checks.integer("n_dirs", n_dirs, 3, 10 ** 6)
         Lt = L.T.tocsr()
         full = []
 
@@ -127,7 +141,7 @@ class ExactSet:
         image from the origin, the exact polygon (:meth:`polygon`) gives a direction that
         does, and the range is computed again around it (``retry``).
         """
-        L = sp.csr_matrix(L)
+        L = _linear_map("L", L, 2, self.n)
         M = sp.diags([float(outer), -1.0]) @ L          # r -> u = (outer g_x, -g_y)
         Mt = M.T.tocsr()
         n0 = self.n_lp

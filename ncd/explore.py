@@ -41,6 +41,9 @@ def random_guess(rng, mu, scale):
 
 def shard_members(n_members, shard, n_shards):
     """Members of shard ``shard`` (0-based) among ``n_shards``: a contiguous block."""
+    n_members = checks.integer("n_members", n_members, 0)
+    n_shards = checks.integer("n_shards", n_shards, 1)
+    shard = checks.integer("shard", shard, 0)
     if not (0 <= shard < n_shards):
         raise ValueError(f"shard {shard} is outside 0..{n_shards - 1}")
     bounds = np.linspace(0, n_members, n_shards + 1).round().astype(int)
@@ -85,6 +88,9 @@ def explore(scene, problem, members, root_seed, init="zero", review="random", gu
     """
     members = checks.explore_args(scene, problem, members, root_seed, init, review, guess_scale,
                                   settings, progress, threads)
+    speed_tol = checks.real("speed_tol", speed_tol, 0.0, lo_open=True)
+    if observe is not None and not callable(observe):
+        raise checks.InputError(f"observe = {observe!r} must be None or a callable (impulse, vel, spin) -> array")
     members = np.asarray(members, dtype=np.int64)
     n = problem.contacts.n
     nm = scene.n_mobile

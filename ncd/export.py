@@ -20,7 +20,9 @@ discs in ``ground_x``, ``ground_y``, ``ground_radius``.
   normal force) as an mp4 through matplotlib and ffmpeg, or an animated GIF
   through Pillow when ffmpeg is absent.
 """
+import os
 import shutil
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -91,13 +93,30 @@ def write_ground(ds, path):
 def write_vtk(ds, outdir, name="flow"):
     """Write ``<outdir>/<name>_discs_<i>.vtu``, ``<name>_contacts_<i>.vtu`` and the two ``.pvd``
     collections (and ``<name>_ground.vtu`` if the dataset has ground discs); returns
-    the paths of the collections (then of the ground file)."""
+    the paths of the collections (then of the ground file).  All or nothing: the files
+    are written in a temporary folder of ``outdir`` and moved into place at the end
+    (frames of an earlier, longer export under the same name are removed)."""
+    outdir = Path(outdir)
+    outdir.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{name}_", dir=outdir))
+    try:
+        out = _write_vtk(ds, tmp, name)
+        new = {f.name for f in tmp.iterdir()}
+        for old in list(outdir.glob(f"{name}_discs_*.vtu")) + list(outdir.glob(f"{name}_contacts_*.vtu")):
+            if old.name not in new:
+                old.unlink()
+        for f in sorted(tmp.iterdir()):
+            os.replace(f, outdir / f.name)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    return [outdir / p.name for p in out]
+
+
+def _write_vtk(ds, outdir, name):
     import meshio
     from pyevtk.vtk import VtkGroup
 
     prefix = frame_prefix(ds)
-    outdir = Path(outdir)
-    outdir.mkdir(parents=True, exist_ok=True)
     times = frame_times(ds, prefix)
     discs = VtkGroup(str(outdir / f"{name}_discs"))
     lines = VtkGroup(str(outdir / f"{name}_contacts")) if f"{prefix}line_x0" in ds else None
@@ -215,6 +234,14 @@ def animate(ds, path, fps=10, title="", period=None, dpi=100):
         return discs, chains, label
 
     anim = animation.FuncAnimation(fig, draw, frames=ds.sizes["frame"], blit=False)
-    anim.save(str(path), writer=writer, dpi=dpi)
-    plt.close(fig)
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}_", suffix=path.suffix, dir=path.parent)
+    os.close(fd)
+    try:                                        # all or nothing: a failed encoding keeps the old file
+        anim.save(tmp, writer=writer, dpi=dpi)
+        os.replace(tmp, path)
+    finally:
+        plt.close(fig)
+        if os.path.exists(tmp):
+            os.unlink(tmp)
     return path

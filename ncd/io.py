@@ -220,4 +220,9 @@ def merge_shards(paths, dim="run"):
     ds.attrs.pop("title", None)
     for var in ds.variables.values():
         var.encoding.pop("dtype", None)  # a string variable must not keep the first shard's width
+    if dim in ds.coords:
+        ids, counts = np.unique(ds[dim].values, return_counts=True)
+        if np.any(counts > 1):
+            raise ValueError(f"shards {[str(p) for p in paths]} repeat {dim} {ids[counts > 1][:5].tolist()}: "
+                             "a shard given twice, or shards of different runs")
     return ds.sortby(dim)

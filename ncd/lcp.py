@@ -25,9 +25,14 @@ so ``sigma = 0`` is forward sliding (``s_t = -mu s_n``, ``U_t >= 0``), ``0 < sig
 import numpy as np
 
 from ._cache import njit
+from . import checks
 from .model import InputError
 
 LEMKE_STATUS = {0: "solution", 1: "secondary ray", 2: "pivot budget exhausted"}
+# ("inaccurate": the final basis's z has a complementarity residual above ACCEPT max(1, |q|))
+ACCEPT = 1e-6
+MAX_ENTRY = 1e150              # |M|, |q| at most: products of two entries stay finite
+MAX_COVERING_RATIO = 1e12      # largest / smallest covering entry
 
 
 @njit(cache=True)
@@ -113,21 +118,19 @@ def lemke(M, q, max_pivots=None, tol=1e-12, covering=None):
     ``info`` with ``status`` (one of :data:`LEMKE_STATUS`), ``pivots`` and the
     complementarity residual ``max |min(z, w)|`` of ``z``.
     """
-    M = np.ascontiguousarray(np.asarray(M, dtype=float))
-    q = np.ascontiguousarray(np.asarray(q, dtype=float).ravel())
+    q = checks.array("q", np.ravel(q) if np.ndim(q) > 1 else q, (None,))
     n = len(q)
-    if M.shape != (n, n):
-        raise InputError(f"M has shape {M.shape}: expected ({n}, {n}) for q of length {n}")
-    if not (np.all(np.isfinite(M)) and np.all(np.isfinite(q))):
-        raise InputError("M and q must be finite")
-    if not (np.isfinite(tol) and tol > 0):
-        raise InputError(f"tol = {tol!r} must be > 0")
-    d = np.ones(n) if covering is None else np.ascontiguousarray(np.asarray(covering, dtype=float).ravel())
-    if d.shape != (n,) or not np.all(d > 0):
-        raise InputError(f"covering must be {n} positive numbers")
-    max_pivots = 50 * n + 100 if max_pivots is None else int(max_pivots)
-    if max_pivots < 1:
-        raise InputError(f"max_pivots = {max_pivots} must be >= 1")
+    M = checks.array("M", M, (n, n))
+    for name, a in (("M", M), ("q", q)):
+        if a.size and np.abs(a).max() > MAX_ENTRY:
+            raise InputError(f"{name} has an entry of size {np.abs(a).max():.3g} > {MAX_ENTRY:g}: "
+                             "pivoting would overflow; rescale the problem")
+    tol = checks.real("tol", tol, 0.0, lo_open=True)
+    d = np.ones(n) if covering is None else checks.array("covering", np.ravel(covering), (n,))
+    if n and not (d.min() >= 1e-150 and d.max() <= MAX_COVERING_RATIO * d.min()):
+        raise InputError(f"covering must be {n} positive numbers >= 1e-150 within a ratio of "
+                         f"{MAX_COVERING_RATIO:g}; got [{d.min():.3g}, {d.max():.3g}]")
+    max_pivots = 50 * n + 100 if max_pivots is None else checks.integer("max_pivots", max_pivots, 1, 10 ** 9)
     if n == 0 or np.all(q >= 0):
         z = np.zeros(n)
         return z, {"status": "solution", "pivots": 0, "residual": lcp_residual(M, q, z)}
@@ -138,6 +141,9 @@ def lemke(M, q, max_pivots=None, tol=1e-12, covering=None):
         return None, info
     z = basis_solution(M, q, basis)
     info["residual"] = lcp_residual(M, q, z)
+    if not info["residual"] <= ACCEPT * max(1.0, float(np.abs(q).max())):   # a basis that does not solve
+        info["status"] = "inaccurate"
+        return None, info
     return z, info
 
 
@@ -177,7 +183,7 @@ def frictional_lcp(W, q, mu):
     W = np.asarray(W, dtype=float)
     q = np.asarray(q, dtype=float).reshape(-1, 2)
     k = len(q)
-    mu = np.broadcast_to(np.asarray(mu, dtype=float), (k,))
+    mu = checks.per_item("mu", mu, k, 0.0)
     if W.shape != (2 * k, 2 * k):
         raise InputError(f"W has shape {W.shape}: expected ({2 * k}, {2 * k}) for {k} contacts")
     # s = P x with x = (s_n, sigma, v) per contact: s_n = s_n, s_t = sigma - mu s_n

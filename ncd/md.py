@@ -32,7 +32,10 @@ import numpy as np
 
 from ._cache import njit
 from .contacts import detect_contacts
+from . import checks, checks_scene
 from .model import InputError
+
+MAX_STEPS = 10 ** 12     # n_steps of one MD.run at most (an int64 count in the kernel)
 
 
 def zeta_from_restitution(e):
@@ -191,6 +194,17 @@ class MD:
     def critical_step(self):
         return critical_step(self.scene, self.params.k_n)
 
+    def _fits(self, s):
+        """The cached contacts index the scene as it is now (sizes, walls, laws)."""
+        c = self._contacts
+        if not (self._ref.shape == s.pos.shape and self._n_walls == len(s.wall_point) and self._n_mobile == s.n_mobile):
+            return False
+        try:
+            checks_scene.contacts(s, c)
+        except InputError:
+            return False
+        return True
+
     def _rebuild(self):
         s = self.scene
         nm = s.n_mobile
@@ -208,15 +222,20 @@ class MD:
         self._meff = 1.0 / (s.inv_mass[c.body_a] + inv_b)
         self._zeta = zeta_from_restitution(c.e_n).astype(float)
         self._ref = s.pos.copy()
+        self._n_walls, self._n_mobile = len(s.wall_point), s.n_mobile
         self._half_skin = 0.5 * skin
 
     def run(self, h, n_steps, speed_limit=np.inf):
-        """Advance ``n_steps`` steps of length ``h``; stops early on divergence."""
-        if not (np.isfinite(h) and h > 0):
-            raise InputError(f"time step h = {h!r} must be > 0")
+        """Advance ``n_steps`` steps of length ``h``; stops early on divergence.  The scene
+        is checked on every call (it may have been changed since the last one), and the
+        contact list is rebuilt when it no longer fits the scene."""
+        h = checks.real("h", h, 0.0, lo_open=True)
+        n_steps = checks.integer("n_steps", n_steps, 0, MAX_STEPS)
+        speed_limit = checks.real("speed_limit", speed_limit, 0.0, lo_open=True, allow_inf=True)
         s, p = self.scene, self.params
+        checks_scene.scene(s, state=True)
         done, rebuilds, max_ov = 0, 0, 0.0
-        if self._contacts is None:
+        if self._contacts is None or not self._fits(s):
             self._rebuild()
         while done < n_steps:
             c = self._contacts

@@ -247,6 +247,8 @@ def solve_discs(scene, contacts, vel, spin, guess=None, review_order=None,
     """
     guess, review_order, bias, W = checks.disc_problem(scene, contacts, vel, spin, guess, review_order,
                                                        settings, bias, W)
+    if observe is not None and not callable(observe):
+        raise checks.InputError(f"observe = {observe!r} must be None or a callable (impulse, vel, spin) -> array")
     n = contacts.n
     impulse = np.zeros((n, 2)) if guess is None else np.array(guess, dtype=float).reshape(n, 2)
     status = np.zeros(n, np.int8)

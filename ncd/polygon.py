@@ -62,6 +62,12 @@ def outside_distance(points, vertices):
     """
     p = np.asarray(points, dtype=float).reshape(-1, 2)
     v = np.asarray(vertices, dtype=float).reshape(-1, 2)
+    if not (np.isfinite(p).all() and np.isfinite(v).all()):
+        raise ValueError("points and vertices must be finite")
+    if len(v) == 0:
+        raise ValueError("a polygon needs at least one vertex")
+    keep = np.any(v != np.roll(v, -1, axis=0), axis=1)             # drop repeated vertices (zero edges)
+    v = v[keep] if keep.any() else v[:1]
     if len(v) < 3:
         a, b = v[0], v[-1]
         ab = b - a
@@ -82,6 +88,12 @@ def boundary_distance(points, vertices):
     """Distance of points inside a convex polygon (ccw) to its boundary (negative outside)."""
     p = np.asarray(points, dtype=float).reshape(-1, 2)
     v = np.asarray(vertices, dtype=float).reshape(-1, 2)
+    if not (np.isfinite(p).all() and np.isfinite(v).all()):
+        raise ValueError("points and vertices must be finite")
+    if len(v) == 0:
+        raise ValueError("a polygon needs at least one vertex")
+    keep = np.any(v != np.roll(v, -1, axis=0), axis=1)             # drop repeated vertices (zero edges)
+    v = v[keep] if keep.any() else v[:1]
     if len(v) < 3:
         return -outside_distance(p, v)
     e = np.roll(v, -1, axis=0) - v

@@ -17,6 +17,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.optimize import linprog
 
+from . import checks
 from ._cache import njit
 from .polygon import (boundary_distance, clip_polygon, convex_hull, hull_area,  # noqa: F401 (re-exported)
                       outside_distance, polygon_area, support_polygon)
@@ -65,14 +66,12 @@ class ForcePolytope:
     """
 
     def __init__(self, H, F, mu):
-        H = sp.csr_matrix(H, dtype=float)
-        F = np.asarray(F, dtype=float).ravel()
+        H = checks.sparse_matrix("H", H) if sp.issparse(H) else sp.csr_matrix(checks.array("H", H, (None, None)))
+        F = checks.array("F", np.asarray(F).ravel() if np.ndim(F) > 1 else F, (None,))
         self.n_contacts = H.shape[1] // 2
         if H.shape != (len(F), 2 * self.n_contacts):
-            raise ValueError(f"H has shape {H.shape}, F length {len(F)}: expected (m, 2 kappa) and m")
-        self.mu = np.broadcast_to(np.asarray(mu, dtype=float), (self.n_contacts,)).copy()
-        if np.any(self.mu < 0):
-            raise ValueError("mu must be >= 0")
+            raise checks.InputError(f"H has shape {H.shape}, F length {len(F)}: expected (m, 2 kappa) and m")
+        self.mu = checks.per_item("mu", mu, self.n_contacts, 0.0)
         self.H, self.F = H, F
         self.scale = float(np.abs(F).max()) if np.abs(F).max() > 0 else 1.0
         rows = np.asarray(abs(H).max(axis=1).todense()).ravel()
@@ -140,8 +139,9 @@ class ForcePolytope:
     # ------------------------------------------------------------ projections
     def support(self, contact, direction):
         """The point of ``A ∩ C`` maximizing ``direction . rho_contact`` (forces, full vector)."""
+        contact = checks.integer("contact", contact, 0, self.n_contacts - 1)
         c = np.zeros(2 * self.n_contacts)
-        c[2 * contact: 2 * contact + 2] = -np.asarray(direction, dtype=float)
+        c[2 * contact: 2 * contact + 2] = -checks.array("direction", direction, (2,))
         x = self._lp(c)
         if x is None:
             raise PolytopeError("A ∩ C is empty")
@@ -159,7 +159,9 @@ class ForcePolytope:
         force units), ``inner_area``, ``outer_area``, ``n_lp``, ``exact``.
         Requires a bounded ``A ∩ C``.
         """
-        dirs = [np.array([np.cos(a), np.sin(a)]) for a in 2 * np.pi * np.arange(n_init) / max(n_init, 3)]
+        contact = checks.integer("contact", contact, 0, self.n_contacts - 1)
+        n_init = checks.integer("n_init", n_init, 3, 10 ** 6)
+        dirs = [np.array([np.cos(a), np.sin(a)]) for a in 2 * np.pi * np.arange(n_init) / n_init]
         return support_polygon(lambda u: self.support(contact, u)[2 * contact: 2 * contact + 2],
                                dirs, tol * self.scale, max_lp, self.scale)
 
@@ -214,6 +216,13 @@ class ForcePolytope:
         Returns ``(samples, info)``; ``info`` has the dimension, the implicit
         equalities and the largest Gelman-Rubin R-hat over coordinates.
         """
+        n_chains = checks.integer("n_chains", n_chains, 1, 10 ** 6)
+        per_chain = checks.integer("per_chain", per_chain, 1, 10 ** 9)
+        thin = None if thin is None else checks.integer("thin", thin, 1, 10 ** 9)
+        burn = None if burn is None else checks.integer("burn", burn, 0, 10 ** 9)
+        rounds = checks.integer("rounds", rounds, 0, 100)
+        if not callable(rng_of):
+            raise checks.InputError(f"rng_of must be a callable k -> numpy Generator; got {rng_of!r}")
         if not self.is_bounded():
             raise PolytopeError("A ∩ C is unbounded: there is no uniform law on it")
         x0, Z, Gz, b, implicit = self.affine_hull()
