@@ -47,10 +47,17 @@ def make_scene(pos, radius, density=1.0, *, obstacle_pos=None, obstacle_radius=N
             raise InputError(f"walls[{k}] = {w!r} must be a (point, normal) pair")
     wp = np.array([checks.array(f"walls[{k}].point", w[0], (2,)) for k, w in enumerate(walls)]).reshape(-1, 2)
     wn = np.array([checks.array(f"walls[{k}].normal", w[1], (2,)) for k, w in enumerate(walls)]).reshape(-1, 2)
-    norms = np.linalg.norm(wn, axis=1)
-    if np.any(norms == 0):
-        raise InputError(f"walls[{int(np.argmin(norms))}].normal is zero")
-    wn = wn / norms[:, None] if len(wn) else wn
+    big = np.abs(wn).max(axis=1) if len(wn) else np.zeros(0)
+    if np.any(big == 0):
+        raise InputError(f"walls[{int(np.argmin(big))}].normal is zero")
+    if len(wn):
+        with np.errstate(over="ignore", under="ignore"):
+            norms = np.linalg.norm(wn, axis=1)
+        odd = ~(np.isfinite(norms) & (norms > 0))       # |(1e300, 1e300)| overflows: scale it first
+        out = wn / np.where(odd, 1.0, norms)[:, None]
+        scaled = wn[odd] / big[odd, None]
+        out[odd] = scaled / np.hypot(scaled[:, 0], scaled[:, 1])[:, None]
+        wn = out
 
     period = 0.0 if period is None else checks.real("period", period, 0.0, lo_open=True)
     if period > 0:
@@ -101,6 +108,11 @@ def check_overlaps(scene, tolerance):
     c = detect_contacts(scene, alert=0.0)
     if c.n == 0:
         return
+    pair = c.body_b >= 0
+    centre = c.gap[pair] + scene.radius[c.body_a[pair]] + scene.radius[c.body_b[pair]]
+    if np.any(centre <= 0):                      # no contact normal: refused whatever the tolerance
+        k = int(np.nonzero(pair)[0][np.argmin(centre)])
+        raise InputError(f"discs {c.body_a[k]} and {c.body_b[k]} have coincident centres (no contact normal)")
     rb = np.where(c.body_b >= 0, scene.radius[np.maximum(c.body_b, 0)], np.inf)
     rmin = np.minimum(scene.radius[c.body_a], rb)
     excess = -c.gap / rmin

@@ -211,3 +211,11 @@ def test_a_failed_vtk_export_leaves_the_old_one_intact(tmp_path, monkeypatch):
         export.write_vtk(ds, tmp_path, "flow")
     after = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
     assert after == before and [p.name for p in first][0] in after
+
+
+def test_huge_wall_normals_are_normalised_and_coincident_centres_refused():
+    s = ncd.make_scene([[0.0, 1.0]], 0.5, walls=[((0, 0), (1e300, 1e300)), ((0, -5), (0.3, 0.7))])
+    np.testing.assert_allclose(s.wall_normal, [[2 ** -0.5, 2 ** -0.5], np.array([0.3, 0.7]) / np.hypot(0.3, 0.7)],
+                               rtol=1e-15)
+    with pytest.raises(ncd.InputError, match=r"discs 0 and 1 have coincident centres"):
+        ncd.make_scene([[0.0, 1.0], [0.0, 1.0]], 0.5, overlap_tolerance=np.inf)
