@@ -25,7 +25,10 @@ review orders; dense packings):
   6 reached 1e-10.  (Restarting only when ``|f|`` grows did not cure the stagnation.)
 
 Measured to a residual of 1e-10 from the zero guess, memory 20 (NLGS sweeps, plain
-NLGS's in brackets): fig2's step 620-900 over 6 review orders (8,720-9,070); 10^3-disc
+NLGS's in brackets): fig2's former step 70 620-900 over 6 review orders (8,720-9,070);
+fig2's step 50, where zero-guess runs end on two solutions, 880-1,310 on 3 orders but
+8,430, 86,630 and 103,970 on the other 3 (7,620-10,670): the extrapolation mixes iterates
+that the status switches send towards different solutions; 10^3-disc
 packing 190-210 (3,440-3,790); 10^4-disc packing 1,110 (29,530).  Wall time 5.1-7.5x,
 8.8-9.5x and 10.5-11.9x shorter: on fig2's step the sweep count falls 10-14x, and the Anderson
 steps take the rest.  The pile's final state (Figure 4) is not helped: NLGS and AA
