@@ -63,7 +63,7 @@ def _scene_ok(s):
         return s.prev_impulse is None
     return (type(pk) is np.ndarray and pk.ndim == 1 and pk.dtype.kind in "iu"
             and _ok(s.prev_impulse, (len(pk), 2)) and s.prev_impulse.flags.c_contiguous
-            and _finite_flat(s.prev_impulse.reshape(-1)))
+            and _finite_flat(s.prev_impulse.reshape(-1)) and bool(np.all(pk[1:] > pk[:-1])))
 
 
 @njit(cache=True)
@@ -124,6 +124,10 @@ def _scene_slow(s, name):
         keys = np.asarray(s.prev_keys)
         if keys.size and keys.dtype.kind not in "iu":
             raise InputError(f"{name}.prev_keys must be integers; got dtype {keys.dtype}")
+        if keys.ndim == 1 and np.any(keys[1:] <= keys[:-1]):
+            k = int(np.argmax(keys[1:] <= keys[:-1]))
+            raise InputError(f"{name}.prev_keys must increase strictly (the warm start searches them); "
+                             f"prev_keys[{k}] = {keys[k]}, prev_keys[{k + 1}] = {keys[k + 1]}")
         if not isinstance(s.prev_impulse, np.ndarray):
             raise InputError(f"{name}.prev_impulse must be a numpy array; got {_show(s.prev_impulse)}")
         array(f"{name}.prev_impulse", s.prev_impulse, (len(keys), 2))

@@ -36,6 +36,8 @@ def make_scene(pos, radius, density=1.0, *, obstacle_pos=None, obstacle_radius=N
     opos = np.zeros((0, 2)) if obstacle_pos is None else checks.array("obstacle_pos", obstacle_pos, (None, 2))
     if len(opos) and obstacle_radius is None:
         raise InputError("obstacle_pos is given without obstacle_radius")
+    if not len(opos) and obstacle_radius is not None and np.size(obstacle_radius):
+        raise InputError(f"obstacle_radius = {obstacle_radius!r} is given without obstacle_pos")
     orad = np.zeros(0) if not len(opos) else checks.per_item("obstacle_radius", obstacle_radius, len(opos),
                                                              0.0, lo_open=True)
     try:

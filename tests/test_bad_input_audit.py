@@ -219,3 +219,16 @@ def test_huge_wall_normals_are_normalised_and_coincident_centres_refused():
                                rtol=1e-15)
     with pytest.raises(ncd.InputError, match=r"discs 0 and 1 have coincident centres"):
         ncd.make_scene([[0.0, 1.0], [0.0, 1.0]], 0.5, overlap_tolerance=np.inf)
+
+
+def test_unsorted_warm_start_keys_and_a_lone_obstacle_radius_are_refused():
+    with pytest.raises(ncd.InputError, match=r"obstacle_radius = 0.5 is given without obstacle_pos"):
+        ncd.make_scene([[0.0, 1.0]], 0.5, obstacle_radius=0.5)
+    s = ncd.make_scene([[0.0, 0.5], [1.0, 0.5]], 0.5, walls=[((0.0, 0.0), (0.0, 1.0))])
+    ncd.step(s, 1e-3)
+    assert len(s.prev_keys) == 3 and np.all(np.diff(s.prev_keys) > 0)
+    s.prev_keys, s.prev_impulse = s.prev_keys[::-1].copy(), s.prev_impulse[::-1].copy()
+    pos = s.pos.copy()
+    with pytest.raises(ncd.InputError, match=r"scene.prev_keys must increase strictly"):
+        ncd.step(s, 1e-3)
+    np.testing.assert_array_equal(s.pos, pos)
