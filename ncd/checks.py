@@ -110,11 +110,11 @@ def array(name, value, shape, finite=True, dtype=float):
     return arr
 
 
-def sparse_matrix(name, M, shape=None):
+def sparse_matrix(name, M):
     """A scipy.sparse ``M`` as a CSR float matrix, its *structure* checked before anything
     reads it: indices within the shape, ``indptr`` monotone and consistent (a CSR or CSC
     with an index out of range, e.g. 1-based, segfaults a sparse product or corrupts the
-    heap when converted), real and finite entries, ``shape`` when given."""
+    heap when converted), real and finite entries."""
     if M.dtype.kind not in "iuf":
         raise InputError(f"{name} must hold real numbers; got dtype {M.dtype}")
     fmt = M.format
@@ -130,11 +130,20 @@ def sparse_matrix(name, M, shape=None):
         raise InputError(f"{name} ({fmt}, shape {M.shape}) has an invalid structure: {exc}") from None
     out = sp.csr_matrix(M, dtype=float)
     out.sum_duplicates()
-    if shape is not None and out.shape != tuple(shape):
-        raise InputError(f"{name} has shape {out.shape}, expected {tuple(shape)}")
     if not np.isfinite(out.data).all():
         raise InputError(f"{name} must be finite; it holds {out.data[~np.isfinite(out.data)][0]!r}")
     return out
+
+
+def matrix(name, M, shape=(None, None)):
+    """A dense or scipy.sparse matrix as CSR float, finite, of ``shape`` (``None``
+    entries: any); a sparse one through :func:`sparse_matrix` (its structure checked)."""
+    if sp.issparse(M):
+        out = sparse_matrix(name, M)
+        if any(k is not None and k != m for k, m in zip(shape, out.shape)):
+            raise InputError(f"{name} has shape {out.shape}, expected {_shape_text(shape)}")
+        return out
+    return sp.csr_matrix(array(name, M, shape))
 
 
 def per_item(name, value, n, lo=-np.inf, hi=np.inf, lo_open=False):
@@ -249,14 +258,11 @@ def local_problem(W, q, mu, guess, review_order, settings):
     if len(q) % 2:
         raise InputError(f"q has length {len(q)}, expected 2 n (rows n_1, t_1, n_2, ...)")
     n = len(q) // 2
-    if sp.issparse(W):
-        Wc = sparse_matrix("W", W)
-        if Wc.shape != (2 * n, 2 * n):
-            raise InputError(f"W has shape {Wc.shape}, q has length {len(q)}: expected (2n, 2n) and 2n")
-    else:
-        shape = shape_of("W", W)
-        if shape != (2 * n, 2 * n):
-            raise InputError(f"W has shape {shape}, q has length {len(q)}: expected (2n, 2n) and 2n")
+    Wc = sparse_matrix("W", W) if sp.issparse(W) else None
+    shape = shape_of("W", W) if Wc is None else Wc.shape
+    if shape != (2 * n, 2 * n):
+        raise InputError(f"W has shape {shape}, q has length {len(q)}: expected (2n, 2n) and 2n")
+    if Wc is None:
         Wc = sp.csr_matrix(array("W", W, shape))
     mu = per_item("mu", mu, n, 0.0)
     if n:

@@ -29,12 +29,17 @@ def scene(s, name="scene", state=False):
     t = s.time
     if isinstance(t, (bool, np.bool_)) or not isinstance(t, numbers.Real) or not np.isfinite(t):
         raise InputError(f"{name}.time = {_show(t)} must be a finite real number")
-    if s.period > 0 and s.period < 3 * 2 * float(s.radius.max()):
-        raise InputError(f"{name}.period = {s.period} must be 0 (not periodic) or at least three largest "
-                         f"diameters ({6 * float(s.radius.max())})")
+    period(f"{name}.period", s.period, float(s.radius.max()))
     if state and not all(np.isfinite(getattr(s, f)).all() for f in ("pos", "vel", "spin", "angle")):
         raise SimulationError(f"{name} state (pos, vel, spin, angle) is non-finite at t = {s.time}")
     return s
+
+
+def period(name, value, largest_radius):
+    """A period along x is 0 (not periodic) or at least three largest diameters (a pair of
+    discs then touches across it once at most)."""
+    if value > 0 and value < 6 * largest_radius:
+        raise InputError(f"{name} = {value} must be at least three largest diameters ({6 * largest_radius})")
 
 
 def _scene_ok(s):

@@ -26,17 +26,6 @@ from .polytope import ForcePolytope, PolytopeError
 FEAS_TOL = 1e-10
 
 
-def _linear_map(name, L, rows, n):
-    """``L`` (dense or sparse) as CSR of shape ``(rows, n)`` (``rows`` None: any), finite."""
-    if sp.issparse(L):
-        L = checks.sparse_matrix(name, L)
-    else:
-        L = sp.csr_matrix(checks.array(name, L, (rows, n)))
-    if (rows is not None and L.shape[0] != rows) or L.shape[1] != n:
-        raise checks.InputError(f"{name} has shape {L.shape}, expected ({'any' if rows is None else rows}, {n})")
-    return L
-
-
 class ExactSet:
     """A ∩ C of ``H r + F = 0`` (r: 2 kappa forces) with Coulomb cones, as one HiGHS model."""
 
@@ -91,7 +80,7 @@ class ExactSet:
 
         All minima first, then all maxima, in row order: neighbouring rows (a
         pressure profile) have neighbouring optima, so each LP restarts close by."""
-        rows = _linear_map("rows", rows, None, self.n)
+        rows = checks.matrix("rows", rows, (None, self.n))
         out = np.empty((rows.shape[0], 2))
         for j, sign in ((0, 1.0), (1, -1.0)):
             for i in range(rows.shape[0]):
@@ -108,7 +97,7 @@ class ExactSet:
         of all supporting half-planes), ``n_lp``, ``exact`` and ``points`` (the
         support points' full force vectors, one per LP).
         """
-        L = _linear_map("L", L, 2, self.n)
+        L = checks.matrix("L", L, (2, self.n))
         n_dirs = checks.integer("n_dirs", n_dirs, 3, 10 ** 6)
         Lt = L.T.tocsr()
         full = []
@@ -141,7 +130,7 @@ class ExactSet:
         image from the origin, the exact polygon (:meth:`polygon`) gives a direction that
         does, and the range is computed again around it (``retry``).
         """
-        L = _linear_map("L", L, 2, self.n)
+        L = checks.matrix("L", L, (2, self.n))
         M = sp.diags([float(outer), -1.0]) @ L          # r -> u = (outer g_x, -g_y)
         Mt = M.T.tocsr()
         n0 = self.n_lp

@@ -55,19 +55,25 @@ def hull_area(points):
     return max(polygon_area(convex_hull(points)), 0.0)
 
 
-def outside_distance(points, vertices):
-    """Distance by which each point lies outside a convex polygon (ccw), 0 inside.
-
-    For a segment or a single vertex it is the distance to that set.
-    """
+def _points_and_polygon(points, vertices):
+    """``(p, v)`` as (m, 2) and (k, 2) float arrays, finite, ``v`` without repeated
+    consecutive vertices (a zero-length edge has no normal)."""
     p = np.asarray(points, dtype=float).reshape(-1, 2)
     v = np.asarray(vertices, dtype=float).reshape(-1, 2)
     if not (np.isfinite(p).all() and np.isfinite(v).all()):
         raise ValueError("points and vertices must be finite")
     if len(v) == 0:
         raise ValueError("a polygon needs at least one vertex")
-    keep = np.any(v != np.roll(v, -1, axis=0), axis=1)             # drop repeated vertices (zero edges)
-    v = v[keep] if keep.any() else v[:1]
+    keep = np.any(v != np.roll(v, -1, axis=0), axis=1)
+    return p, (v[keep] if keep.any() else v[:1])
+
+
+def outside_distance(points, vertices):
+    """Distance by which each point lies outside a convex polygon (ccw), 0 inside.
+
+    For a segment or a single vertex it is the distance to that set.
+    """
+    p, v = _points_and_polygon(points, vertices)
     if len(v) < 3:
         a, b = v[0], v[-1]
         ab = b - a
@@ -86,14 +92,7 @@ def outside_distance(points, vertices):
 
 def boundary_distance(points, vertices):
     """Distance of points inside a convex polygon (ccw) to its boundary (negative outside)."""
-    p = np.asarray(points, dtype=float).reshape(-1, 2)
-    v = np.asarray(vertices, dtype=float).reshape(-1, 2)
-    if not (np.isfinite(p).all() and np.isfinite(v).all()):
-        raise ValueError("points and vertices must be finite")
-    if len(v) == 0:
-        raise ValueError("a polygon needs at least one vertex")
-    keep = np.any(v != np.roll(v, -1, axis=0), axis=1)             # drop repeated vertices (zero edges)
-    v = v[keep] if keep.any() else v[:1]
+    p, v = _points_and_polygon(points, vertices)
     if len(v) < 3:
         return -outside_distance(p, v)
     e = np.roll(v, -1, axis=0) - v

@@ -66,7 +66,7 @@ class ForcePolytope:
     """
 
     def __init__(self, H, F, mu):
-        H = checks.sparse_matrix("H", H) if sp.issparse(H) else sp.csr_matrix(checks.array("H", H, (None, None)))
+        H = checks.matrix("H", H)
         F = checks.array("F", np.asarray(F).ravel() if np.ndim(F) > 1 else F, (None,))
         self.n_contacts = H.shape[1] // 2
         if H.shape != (len(F), 2 * self.n_contacts):

@@ -2,7 +2,7 @@
 import numpy as np
 
 from .contacts import detect_contacts
-from . import checks
+from . import checks, checks_scene
 from .model import InputError, Scene
 
 
@@ -62,10 +62,8 @@ def make_scene(pos, radius, density=1.0, *, obstacle_pos=None, obstacle_radius=N
         wn = out
 
     period = 0.0 if period is None else checks.real("period", period, 0.0, lo_open=True)
+    checks_scene.period("period", period, max(radius.max(), orad.max() if len(orad) else 0.0))
     if period > 0:
-        dmax = 2 * max(radius.max(), orad.max() if len(orad) else 0.0)
-        if period < 3 * dmax:
-            raise InputError(f"period = {period} must be at least three largest diameters ({3 * dmax})")
         pos = pos.copy()
         pos[:, 0] %= period
         opos = opos.copy()

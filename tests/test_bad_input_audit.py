@@ -166,7 +166,7 @@ def test_scene_time_is_checked_before_anything_moves(time):
 def test_a_period_shrunk_below_three_diameters_is_named():
     s = ncd.make_scene([[0.0, 0.5], [1.5, 0.5]], 0.5, walls=[((0.0, 0.0), (0.0, 1.0))], period=10.0)
     s.period = 2.0
-    with pytest.raises(ncd.InputError, match=r"scene.period = 2.0 must be 0 \(not periodic\) or at least three"):
+    with pytest.raises(ncd.InputError, match=r"scene\.period = 2\.0 must be at least three largest diameters"):
         ncd.step(s, 1e-3)
 
 
