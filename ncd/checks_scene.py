@@ -17,6 +17,8 @@ from .model import InputError, Scene, SimulationError
 MAX_GRID_CELLS = 1e7      # cells of the contact detection grid (8 bytes each)
 
 
+MASS_RTOL = 1e-12      # |mass inv_mass - 1| of a mobile disc (make_scene: 1 / mass, a rounding at most)
+
 def scene(s, name="scene", state=False):
     """A :class:`ncd.Scene` whose arrays are consistent: the shapes the kernels
     index, finite radii, masses and laws.  The *state* (``pos``, ``vel``,
@@ -78,7 +80,8 @@ def _scene_values_ok(r, inv_mass, inv_inertia, mass, nm, wp, wn, g):
         if not (r[i] > 0.0 and r[i] < np.inf and inv_mass[i] >= 0.0 and inv_inertia[i] >= 0.0
                 and inv_mass[i] + r[i] * r[i] * inv_inertia[i] <= 1e300):
             return False
-        if i < nm and not (inv_mass[i] > 0.0 and mass[i] > 0.0 and mass[i] < np.inf):
+        if i < nm and not (inv_mass[i] > 0.0 and mass[i] > 0.0 and mass[i] < np.inf
+                           and abs(mass[i] * inv_mass[i] - 1.0) <= MASS_RTOL):
             return False
     return _finite_flat(wp) and _finite_flat(wn) and _finite_flat(g)
 
@@ -105,6 +108,12 @@ def _scene_slow(s, name):
         raise InputError(f"{name}.mass of the mobile discs must be finite and > 0")
     if np.any(s.inv_mass[: s.n_mobile] <= 0):
         _first_bad(f"{name}.inv_mass", s.inv_mass, s.inv_mass <= 0, "must be > 0 for mobile discs")
+    with np.errstate(over="ignore", invalid="ignore"):
+        off = ~(np.abs(s.mass[: s.n_mobile] * s.inv_mass[: s.n_mobile] - 1.0) <= MASS_RTOL)
+    if np.any(off):
+        i = int(np.argmax(off))
+        raise InputError(f"{name}.inv_mass[{i}] = {s.inv_mass[i]!r} is not 1 / mass[{i}] = {1.0 / s.mass[i]!r}: "
+                         f"the solver uses inv_mass, the energies and weights use mass")
     if np.any(s.inv_mass < 0) or np.any(s.inv_inertia < 0):
         raise InputError(f"{name}.inv_mass and inv_inertia must be >= 0")
     with np.errstate(over="ignore", invalid="ignore"):

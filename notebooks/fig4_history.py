@@ -127,7 +127,9 @@ and the rained deposit has {'a hump (negative dip, band below 0)' if R['hi'] < 0
 **Arching.** Over all cuts and piles the resultant is on median {P['dev_median']:.1f}° (point)
 and {R['dev_median']:.1f}° (rain) steeper than the flank (interquartile range
 {P['dev_iqr']:.1f}° and {R['dev_iqr']:.1f}°); it is steeper than the free surface at
-{100 * P['arching']:.0f} % and {100 * R['arching']:.0f} % of the cuts. (Arching here means a
+{100 * P['arching']:.0f} % and {100 * R['arching']:.0f} % of the cuts that cross a contact
+({P['empty_cuts']} of {P['cuts']} point-source cuts and {R['empty_cuts']} of {R['cuts']} rain cuts,
+near the toes, cross none and have no resultant direction). (Arching here means a
 resultant steeper than the flank; the exact test of `fig4_pile` uses a weaker one, a
 resultant that pushes the bank downward, $F_y < 0$.)
 """))

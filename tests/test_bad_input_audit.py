@@ -232,3 +232,15 @@ def test_unsorted_warm_start_keys_and_a_lone_obstacle_radius_are_refused():
     with pytest.raises(ncd.InputError, match=r"scene.prev_keys must increase strictly"):
         ncd.step(s, 1e-3)
     np.testing.assert_array_equal(s.pos, pos)
+
+
+def test_an_inverse_mass_that_is_not_one_over_the_mass_is_named():
+    s = ncd.make_scene([[0.0, 0.5], [1.5, 2.0]], 0.5, walls=[((0.0, 0.0), (0.0, 1.0))])
+    s.inv_mass[1] = 2.0 * s.inv_mass[1]          # the solver would move a disc of another mass
+    pos = s.pos.copy()
+    with pytest.raises(ncd.InputError, match=r"scene\.inv_mass\[1\] = .* is not 1 / mass\[1\]"):
+        ncd.step(s, 1e-3)
+    np.testing.assert_array_equal(s.pos, pos)
+    s.inv_mass[1] = 1.0 / s.mass[1]
+    ncd.step(s, 1e-3)                               # consistent again: it steps
+    assert s.pos[1, 1] < pos[1, 1]

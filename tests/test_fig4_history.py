@@ -186,6 +186,16 @@ def test_profile_and_dip_by_hand():
     assert d[1] < -0.1
 
 
+def test_a_cut_crossing_no_contact_has_no_direction():
+    from ncd.figures import cuts
+    # arctan2(-0.0, -0.0) is -180 degrees: an empty left cut read as a 163-degree "deviation"
+    phi, dev = cuts.flank_angles(np.array([-0.0, 0.0, -2.0]), np.array([0.0, -0.0, -1.0]),
+                                 np.array([-1, 1, -1]), 16.5)
+    assert np.isnan(phi[:2]).all() and np.isnan(dev[:2]).all()
+    assert phi[2] == pytest.approx(np.degrees(np.arctan2(1.0, 2.0)), abs=1e-12)
+    assert dev[2] == pytest.approx(phi[2] - 16.5, abs=1e-12)
+
+
 def test_permutation_detects_a_difference_and_not_a_null():
     rng = np.random.default_rng(0)
     xi = np.linspace(-1.3, 1.3, 131)
@@ -280,6 +290,17 @@ def test_bands_are_over_piles(analysis, piles, results):
     assert float((analysis.profile_hi - analysis.profile_lo).max()) > 0.01
     assert np.all(analysis.profile_lo <= analysis.profile_mean + 1e-12)
     np.testing.assert_allclose(analysis.ground_fy / analysis.weight, 1.0, atol=WEIGHT_TOL)
+
+
+def test_empty_cuts_are_left_out_of_the_arching_statistics(analysis):
+    dev, count = analysis.cut_deviation.values, analysis.cut_count.values
+    assert np.array_equal(np.isnan(dev), count == 0)
+    # the medians over piles and their bands are nan-aware: no spurious +-180 degree directions
+    for v in ("deviation_median", "deviation_median_lo", "deviation_median_hi"):
+        x = analysis[v].values
+        assert np.nanmax(np.abs(x)) < 60.0, v
+    med = np.nanmedian(dev[0, :, 0, 0])
+    assert float(analysis.deviation_median.values[0, 0, 0]) == pytest.approx(med, abs=1e-12)
 
 
 # ------------------------------------------------------------------ size study

@@ -148,6 +148,10 @@ def fit_flanks(x, height, x_axis, fit_range):
 
 def flank_angles(fx, fy, outer, surface_angle):
     """Angle (degrees, below the horizontal, pointing outward) of a cut resultant, and
-    its deviation from the free-surface slope (positive: steeper than the surface)."""
-    phi = np.degrees(np.arctan2(-np.asarray(fy), outer * np.asarray(fx)))
+    its deviation from the free-surface slope (positive: steeper than the surface).
+    A zero resultant (a cut that crosses no contact, near a toe) has no direction: NaN
+    (``arctan2(0, 0)`` would give 0 or ±180 degrees by the signs of the zeros)."""
+    fx, fy = np.asarray(fx, float), np.asarray(fy, float)
+    phi = np.degrees(np.arctan2(-fy, outer * fx))
+    phi = np.where((fx == 0.0) & (fy == 0.0), np.nan, phi)
     return phi, phi - surface_angle

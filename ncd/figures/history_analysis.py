@@ -13,7 +13,9 @@ Per pile (history forces: the warm-started equilibrium test of its final state):
   under the apex, < 0 a hump;
 * arching: the resultant across vertical cuts at ``x = ± q L`` (whole column,
   :func:`ncd.figures.cuts.cut_matrix`), its angle below the horizontal and its
-  deviation from the pile's own flank slope (:func:`ncd.figures.cuts.flank_angles`).
+  deviation from the pile's own flank slope (:func:`ncd.figures.cuts.flank_angles`);
+  a cut crossing no contact (near a toe) has no resultant direction: NaN, left out of
+  the statistics over piles (its count is ``cut_count``).
 
 Ensemble statistics resample *piles* (never runs of one pile): the mean profile with
 a percentile bootstrap band, the dip of the mean profile with its band, the
@@ -25,6 +27,8 @@ outside its own percentile band [0.210, 0.377]); its bands, and those of the
 difference, are *basic* (reverse-percentile) bootstrap bands
 ``[2 t - q_hi, 2 t - q_lo]`` (:func:`basic_band`), which correct that bias to first order.
 """
+import warnings
+
 import numpy as np
 import xarray as xr
 
@@ -35,6 +39,14 @@ from .sources import mean_diameter
 
 CERTIFIED_DEG = 1e-6   # an exact angle range is certified when its error bound (angle_bound) is below this
 
+
+
+def _nan(stat, a, *args, **kw):
+    """A nan-aware statistic of ``a`` (cuts crossing no contact are NaN), an all-NaN
+    slice giving NaN without a warning."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return stat(a, *args, **kw)
 
 def stress_profile(x, fy, weight, L, xi, width):
     """Kernel-averaged ground stress at ``xi`` (units of ``W / (2 L)``); ``width`` in m."""
@@ -167,7 +179,7 @@ def ensemble_dataset(cfg, files, exact=None):
     dev = stack("cut_deviation")                  # (history, pile, flank, position)
     ang = stack("cut_angle")
     q = np.asarray(a["cut_positions"], float)
-    boot_med = np.median(dev[:, idx], axis=2)     # (history, B, flank, position)
+    boot_med = _nan(np.nanmedian, dev[:, idx], axis=2)    # (history, B, flank, position)
     ex_lo, ex_hi, ex_out, ex_done, ex_conf = exact_arrays(exact, hist, n, dev.shape[2:])
     one = lambda dims, v, u, ln: (dims, v, {"units": u, "long_name": ln})  # noqa: E731
     H, P, K, X, F, Q = "history", "pile", "kernel", "xi", "flank", "cut_position"
@@ -187,18 +199,19 @@ def ensemble_dataset(cfg, files, exact=None):
             "dip_diff_lo": one((K,), diff_lo, "1", "basic bootstrap band of dip_diff, lower"),
             "dip_diff_hi": one((K,), diff_hi, "1", "basic bootstrap band of dip_diff, upper"),
             "dip_diff_p": one((K,), p_value, "1", "two-sided permutation p-value of dip_diff (labels over piles)"),
-            "cut_deviation": one((H, P, F, Q), dev, "degree", "cut resultant angle minus free-surface slope"),
+            "cut_deviation": one((H, P, F, Q), dev, "degree", "cut resultant angle minus free-surface slope "
+                                 "(NaN: the cut crosses no contact)"),
             "cut_angle": one((H, P, F, Q), ang, "degree", "cut resultant angle below the horizontal, outward"),
             "cut_count": one((H, P, F, Q), stack("cut_count"), "1", "contacts crossing the cut"),
-            "deviation_median": one((H, F, Q), np.median(dev, axis=1), "degree",
-                                    "median over piles of the cut deviation"),
-            "deviation_q25": one((H, F, Q), np.quantile(dev, 0.25, axis=1), "degree",
+            "deviation_median": one((H, F, Q), _nan(np.nanmedian, dev, axis=1), "degree",
+                                    "median over piles of the cut deviation (cuts crossing no contact left out)"),
+            "deviation_q25": one((H, F, Q), _nan(np.nanquantile, dev, 0.25, axis=1), "degree",
                                  "25th percentile over piles of the cut deviation"),
-            "deviation_q75": one((H, F, Q), np.quantile(dev, 0.75, axis=1), "degree",
+            "deviation_q75": one((H, F, Q), _nan(np.nanquantile, dev, 0.75, axis=1), "degree",
                                  "75th percentile over piles of the cut deviation"),
-            "deviation_median_lo": one((H, F, Q), np.quantile(boot_med, lo, axis=1), "degree",
+            "deviation_median_lo": one((H, F, Q), _nan(np.nanquantile, boot_med, lo, axis=1), "degree",
                                        "bootstrap band over piles of the median deviation, lower"),
-            "deviation_median_hi": one((H, F, Q), np.quantile(boot_med, hi, axis=1), "degree",
+            "deviation_median_hi": one((H, F, Q), _nan(np.nanquantile, boot_med, hi, axis=1), "degree",
                                        "bootstrap band over piles of the median deviation, upper"),
             "surface_angle": one((H, P, F), stack("surface_angle")[..., 0], "degree", "flank slope of the pile"),
             "base_half_width": one((H, P), stack("base_half_width"), "m",

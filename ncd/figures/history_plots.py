@@ -125,7 +125,10 @@ def summary(an):
                       dev_median=float(an.cut_deviation.sel(history=h).median()),
                       dev_iqr=float(an.cut_deviation.sel(history=h).quantile(0.75)
                                     - an.cut_deviation.sel(history=h).quantile(0.25)),
-                      arching=float((an.cut_deviation.sel(history=h) > 0).mean()))
+                      arching=float((an.cut_deviation.sel(history=h) > 0).sum()
+                                    / np.isfinite(an.cut_deviation.sel(history=h)).sum()),
+                      empty_cuts=int(np.isnan(an.cut_deviation.sel(history=h)).sum()),
+                      cuts=int(an.cut_deviation.sel(history=h).size))
     for h in an.history.values:
         out[h].update(grains=float(an.n_grains.sel(history=h).mean()),
                       grains_min=int(an.n_grains.sel(history=h).min()), grains_max=int(an.n_grains.sel(history=h).max()),
