@@ -15,9 +15,8 @@ from .checks import (_F64, _finite_flat, _first_bad, _ok, _show, array, impulse_
 from .model import InputError, Scene, SimulationError
 
 MAX_GRID_CELLS = 1e7      # cells of the contact detection grid (8 bytes each)
+MASS_RTOL = 1e-12         # |mass inv_mass - 1| of a mobile disc (make_scene: 1 / mass, a rounding at most)
 
-
-MASS_RTOL = 1e-12      # |mass inv_mass - 1| of a mobile disc (make_scene: 1 / mass, a rounding at most)
 
 def scene(s, name="scene", state=False):
     """A :class:`ncd.Scene` whose arrays are consistent: the shapes the kernels

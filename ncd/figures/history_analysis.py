@@ -40,13 +40,13 @@ from .sources import mean_diameter
 CERTIFIED_DEG = 1e-6   # an exact angle range is certified when its error bound (angle_bound) is below this
 
 
-
 def _nan(stat, a, *args, **kw):
     """A nan-aware statistic of ``a`` (cuts crossing no contact are NaN), an all-NaN
     slice giving NaN without a warning."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         return stat(a, *args, **kw)
+
 
 def stress_profile(x, fy, weight, L, xi, width):
     """Kernel-averaged ground stress at ``xi`` (units of ``W / (2 L)``); ``width`` in m."""
