@@ -77,7 +77,16 @@ def driver(flat, memory):
     def iterate(data, order, status, scale, tol, max_sweeps, criterion, check_every, best):
         return _iterate_anderson(data, order, status, scale, tol, max_sweeps, criterion, check_every, best, aa)
     iterate.state = aa
+    iterate.reset = lambda: reset(aa)
     return iterate
+
+
+def reset(aa):
+    """Forget the history and the restarts (after the iterate was changed from outside,
+    :mod:`ncd.local_exact`): the next sweeps start a fresh extrapolation."""
+    counters, mark = aa[8], aa[9]
+    counters[:] = 0
+    mark[0] = np.inf
 
 
 @njit(cache=True, error_model="numpy")

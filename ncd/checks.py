@@ -230,8 +230,9 @@ def solver_settings(settings, name="settings"):
     for field in ("finish_tol", "observable_tol"):
         if hasattr(settings, field):
             object.__setattr__(settings, field, real(f"{name}.{field}", getattr(settings, field), 0.0, lo_open=True))
-    if hasattr(settings, "keep_best") and not isinstance(settings.keep_best, (bool, np.bool_)):
-        raise InputError(f"{name}.keep_best = {settings.keep_best!r} must be True or False")
+    for field in ("keep_best", "local_exact"):
+        if hasattr(settings, field) and not isinstance(getattr(settings, field), (bool, np.bool_)):
+            raise InputError(f"{name}.{field} = {getattr(settings, field)!r} must be True or False")
     return settings
 
 

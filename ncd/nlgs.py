@@ -53,6 +53,9 @@ class SolverSettings:
     ``accel``: "none" (plain NLGS) or "anderson" (:mod:`ncd.anderson`: Anderson
     acceleration of the sweeps with ``accel_memory`` stored differences, disc form only;
     memory 0 is plain NLGS).
+    ``local_exact``: where the residual stalls, the contacts drifting most and their
+    grains' other contacts solved exactly by Lemke's method, the other impulses frozen
+    (:mod:`ncd.local_exact`; disc form only).
     """
     tol: float = 1e-8
     max_sweeps: int = 20000
@@ -64,6 +67,7 @@ class SolverSettings:
     keep_best: bool = True
     accel: str = "none"           # "none" or "anderson"
     accel_memory: int = 20
+    local_exact: bool = False
 
     def __post_init__(self):
         checks.solver_settings(self)    # InputError naming the field (issue 14)
@@ -99,6 +103,7 @@ class NLGSResult:
     finish_correction: float = 0.0          # relative L1 size of the accepted projection (0: none)
     observable_change: float = float("nan")  # relative change of the observable (nan: not observed)
     best_sweep: int = 0                     # sweep of the returned iterate (keep_best), 0: the last
+    local_solves: int = 0                   # local exact solves (ncd.local_exact; 0: none)
 
     @property
     def impulse_n(self):
@@ -269,8 +274,16 @@ def solve_discs(scene, contacts, vel, spin, guess=None, review_order=None,
     _apply_all(*flat)
     from .convergence import run_nlgs
     look = None if observe is None else (lambda: observe(impulse, body[:-1, :2], body[:-1, 2]))
+    local = None
+    if settings.local_exact:
+        from .local_exact import LocalExact
+        nm = scene.n_mobile
+        local = LocalExact(scene, contacts, np.column_stack([vel[:nm], spin[:nm]]).ravel(), q_free, flat,
+                           getattr(iterate, "reset", None))
+        iterate = local.driver(iterate)
     result = run_nlgs(iterate, flat, order, status, _scale(q_free, W), settings, look)
     result.impulse = impulse
+    result.local_solves = 0 if local is None else local.solves
     if settings.finish != "none":
         from .finish import polish_discs
         result = polish_discs(scene, contacts, vel, spin, bias, q_free, W, flat, order, result, settings)
@@ -350,6 +363,9 @@ def solve_local(W, q, mu, guess=None, review_order=None, settings=SolverSettings
     W, q, mu, guess, review_order = checks.local_problem(W, q, mu, guess, review_order, settings)
     if settings.accel != "none":
         raise checks.InputError(f"settings.accel = {settings.accel!r}: acceleration is implemented "
+                                "for the disc form (solve_discs, solve_problem) only")
+    if settings.local_exact:
+        raise checks.InputError("settings.local_exact = True: local exact solves are implemented "
                                 "for the disc form (solve_discs, solve_problem) only")
     if len(q) == 0:
         return NLGSResult(np.zeros((0, 2)), np.zeros(0, np.int8), 0, 0.0, 0.0, True)

@@ -1,0 +1,129 @@
+"""Local exact solves where NLGS stalls (issue 13, item 2): ``SolverSettings(local_exact=True)``.
+
+On Figure 2's step NLGS (plain or Anderson-accelerated) reaches a residual of ~1e-7
+in a few thousand sweeps from the previous step's impulses, then stays there for
+~150,000 sweeps: a few contacts drift by a constant small amount per sweep towards
+the solution, along a direction the sweeps barely move.  A local exact solve goes
+there at once.  The run is made in chunks of :data:`CHUNK` sweeps; when the residual
+has not fallen below :data:`STALL_FACTOR` of its value :data:`STALL_WINDOW` chunks
+earlier, the *region* is formed:
+
+* its seed: the :data:`SEED` contacts whose impulses moved most over the last chunk
+  (the drift);
+* grown by the other contacts of the seed's mobile grains, at most
+  :data:`MAX_REGION` contacts (those that moved most).
+
+With every other impulse frozen, the region's problem ``U_R = W_RR s_R + q_R`` is
+the LCP of :func:`ncd.lcp.frictional_lcp` (size 3 x region), solved exactly by
+Lemke's method (:func:`ncd.lcp.lemke`); its solution replaces the region's impulses,
+the body velocities are recomputed (``u = u_free + M^-1 H s``), Anderson's history
+is cleared, and the sweeps go on.  A Lemke run without a solution leaves the
+iterate as it is.  The stopping test, the residual and the best-iterate record stay
+those of :mod:`ncd.nlgs` (the returned iterate is a sweep's output).
+
+Measured on Figure 2's step 50 (552 contacts, 6 review orders, experiments in
+``benchmarks``/README): from the previous step's impulses plain NLGS needs
+139,300-155,180 sweeps to 1e-10; with local solves 9,210-10,370; with Anderson and
+local solves 1,150-2,350, on the same solution as plain NLGS (accelerations within
+4e-7 g).  Seeding the region with the largest natural-map residuals instead of the
+drift left one order of six on its plateau (the region's Lemke solution was the
+iterate itself).
+"""
+import numpy as np
+
+from .finish import global_delassus
+from .lcp import frictional_lcp, impulse_of_lcp, lemke
+
+CHUNK = 100          # sweeps between stall tests
+STALL_WINDOW = 5     # chunks over which the residual must fall ...
+STALL_FACTOR = 0.5   # ... below this fraction of its value, or the region is solved exactly
+SEED = 12            # contacts that moved most over the last chunk
+MAX_REGION = 60      # contacts of a region at most (Lemke's tableau is dense: 180 x 360)
+
+
+def solve_region(W, q, mu, s, idx):
+    """Impulses ``(len(idx), 2)`` of the contacts ``idx`` solving ``U = W s + q`` with the
+    Coulomb law there, every other impulse of ``s`` (flat, ``2 kappa``) frozen: the LCP of
+    :func:`ncd.lcp.frictional_lcp` on ``W_RR`` and ``q_R = q_R + W_R,other s_other``,
+    by Lemke's method, in units where ``q_R`` and the diagonal of ``W_RR`` are of order one
+    (the law is invariant under a scaling of impulses and of velocities).  None when Lemke
+    gives no solution."""
+    dof = np.column_stack([2 * idx, 2 * idx + 1]).ravel()
+    Wrr = W[dof][:, dof].toarray()
+    q_r = (W[dof] @ s + q[dof]) - Wrr @ s[dof]
+    V = float(np.abs(q_r).max())
+    if not V > 0:
+        return np.zeros((len(idx), 2))
+    S = V / float(Wrr.diagonal().max())
+    A, b = frictional_lcp(Wrr * (S / V), q_r / V, mu[idx])
+    z, _ = lemke(A, b)
+    return None if z is None else S * impulse_of_lcp(z, mu[idx])
+
+
+class LocalExact:
+    """The stall test and the local exact solves of one disc-form run."""
+
+    def __init__(self, scene, contacts, free, q_free, flat, reset=None):
+        self.W, self.H, self.minv = global_delassus(scene, contacts)
+        self.W = self.W.tocsr()
+        self.q = np.asarray(q_free, float).ravel()
+        self.mu = contacts.mu
+        self.a, self.b = contacts.body_a, contacts.body_b
+        self.nm = scene.n_mobile
+        self.body = flat[2].reshape(-1, 4)
+        self.imp = flat[3]
+        self.free = free                                        # u_free of the mobile grains (3 nm,)
+        self.reset = reset
+        self.solves = 0
+        self.failed = 0
+
+    def region(self, moved):
+        """Contacts of the region: the seed (largest ``moved``) and its grains' other contacts."""
+        seed = np.argsort(-moved, kind="stable")[:SEED]
+        grains = np.concatenate([self.a[seed], self.b[seed]])
+        grains = grains[grains < self.nm]
+        near = np.flatnonzero(np.isin(self.a, grains) | np.isin(self.b, grains))
+        near = near[np.argsort(-moved[near], kind="stable")][:MAX_REGION]
+        return np.union1d(seed, near)
+
+    def solve(self, moved):
+        """Solve the region of ``moved`` exactly, the other impulses frozen; True if done."""
+        idx = self.region(moved)
+        s_region = solve_region(self.W, self.q, self.mu, self.imp, idx)
+        if s_region is None:
+            self.failed += 1
+            return False
+        self.solves += 1
+        s = self.imp
+        s.reshape(-1, 2)[idx] = s_region
+        self.body[:self.nm, :3] = (self.free + self.minv * (self.H @ s)).reshape(self.nm, 3)
+        if self.reset is not None:
+            self.reset()
+        return True
+
+    def driver(self, iterate):
+        """A callable with the signature of :func:`ncd.nlgs._iterate_discs`: ``iterate``
+        in chunks of :data:`CHUNK` sweeps, a local exact solve at each stall."""
+        from .nlgs import _residual_discs
+        history = []
+
+        def run(data, order, status, scale, tol, max_sweeps, criterion, check_every, best):
+            done = 0
+            res, change, ok = np.inf, np.inf, False
+            keep, keep_imp, keep_status, keep_body, k0 = best
+            while done < max_sweeps and not ok:
+                before = self.imp.copy()
+                k, res, change, ok = iterate(data, order, status, scale, tol, min(CHUNK, max_sweeps - done),
+                                             criterion, check_every, (keep, keep_imp, keep_status, keep_body,
+                                                                      k0 + done))
+                done += int(k)
+                if ok:
+                    break
+                rsq, ssq = _residual_discs(data)
+                history.append(np.sqrt(rsq) / max(scale, np.sqrt(ssq), 1e-300))
+                if len(history) > STALL_WINDOW and history[-1] > STALL_FACTOR * history[-1 - STALL_WINDOW]:
+                    moved = np.abs(self.imp - before).reshape(-1, 2).sum(axis=1)
+                    self.solve(moved)
+                    history.clear()
+            return done, res, change, ok
+        return run
