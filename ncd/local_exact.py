@@ -21,13 +21,15 @@ is cleared, and the sweeps go on.  A Lemke run without a solution leaves the
 iterate as it is.  The stopping test, the residual and the best-iterate record stay
 those of :mod:`ncd.nlgs` (the returned iterate is a sweep's output).
 
-Measured on Figure 2's step 50 (552 contacts, 6 review orders, experiments in
-``benchmarks``/README): from the previous step's impulses plain NLGS needs
-139,300-155,180 sweeps to 1e-10; with local solves 9,210-10,370; with Anderson and
-local solves 1,150-2,350, on the same solution as plain NLGS (accelerations within
-4e-7 g).  Seeding the region with the largest natural-map residuals instead of the
-drift left one order of six on its plateau (the region's Lemke solution was the
-iterate itself).
+Measured on Figure 2's step 50 (552 contacts) from the previous step's impulses, to
+1e-10 (the benchmark ``bench_tolerance``, identity and 2 random review orders): plain NLGS
+150,930-165,130 sweeps, 0.94 s; with local solves 8,870-9,970 sweeps, 0.059-0.064 s; with
+Anderson and local solves 1,600-2,130 sweeps, 0.022-0.028 s; both on plain NLGS's own
+solution (end-of-step velocities within 7e-7 |g| h).  Seeding the region with the largest
+natural-map residuals instead of the drift left one of six orders on its plateau (the
+region's Lemke solution was the stalled iterate itself).  Where the slow mode is global
+(the pile's final state, Figure 4) local solves do not help: :mod:`ncd.finish` is the
+route there.
 """
 import numpy as np
 
@@ -103,27 +105,37 @@ class LocalExact:
 
     def driver(self, iterate):
         """A callable with the signature of :func:`ncd.nlgs._iterate_discs`: ``iterate``
-        in chunks of :data:`CHUNK` sweeps, a local exact solve at each stall."""
+        in chunks of at most :data:`CHUNK` sweeps, the residual recorded every
+        :data:`CHUNK` sweeps (across calls: the chunked runs of :mod:`ncd.convergence`
+        call it ``check_every`` sweeps at a time), a local exact solve after a stall.
+        The solve is made before the next sweeps, never as a call's last act: the
+        iterate a call returns is always a sweep's output."""
         from .nlgs import _residual_discs
         history = []
+        period = {"start": None, "since": 0, "pending": None}
 
         def run(data, order, status, scale, tol, max_sweeps, criterion, check_every, best):
             done = 0
             res, change, ok = np.inf, np.inf, False
             keep, keep_imp, keep_status, keep_body, k0 = best
             while done < max_sweeps and not ok:
-                before = self.imp.copy()
-                k, res, change, ok = iterate(data, order, status, scale, tol, min(CHUNK, max_sweeps - done),
-                                             criterion, check_every, (keep, keep_imp, keep_status, keep_body,
-                                                                      k0 + done))
+                if period["pending"] is not None:
+                    self.solve(period["pending"])
+                    period["pending"] = None
+                if period["start"] is None:
+                    period["start"] = self.imp.copy()
+                k, res, change, ok = iterate(data, order, status, scale, tol,
+                                             min(CHUNK - period["since"], max_sweeps - done), criterion,
+                                             check_every, (keep, keep_imp, keep_status, keep_body, k0 + done))
                 done += int(k)
-                if ok:
-                    break
+                period["since"] += int(k)
+                if ok or period["since"] < CHUNK:
+                    continue
                 rsq, ssq = _residual_discs(data)
                 history.append(np.sqrt(rsq) / max(scale, np.sqrt(ssq), 1e-300))
                 if len(history) > STALL_WINDOW and history[-1] > STALL_FACTOR * history[-1 - STALL_WINDOW]:
-                    moved = np.abs(self.imp - before).reshape(-1, 2).sum(axis=1)
-                    self.solve(moved)
+                    period["pending"] = np.abs(self.imp - period["start"]).reshape(-1, 2).sum(axis=1)
                     history.clear()
+                period["start"], period["since"] = None, 0
             return done, res, change, ok
         return run

@@ -35,7 +35,8 @@
 #    stopping criterion natural-map residual or impulse change, or NLGS with the finishing
 #    stage of `ncd.finish` (criterion `finish`: NLGS to $10^{-4}$, then, where NLGS's rate
 #    is slow, the projection on the polyhedron of its contact statuses), or Anderson-accelerated
-#    NLGS (criterion `anderson`, `ncd.anderson`), tolerance) gives one
+#    NLGS (criterion `anderson`, `ncd.anderson`), or the same with local exact solves where
+#    it stalls (criterion `anderson_local`, `ncd.local_exact`), tolerance) gives one
 #    point: its wall time (best of a few repeats), its sweeps, its relative natural-map
 #    residual $|s - \mathrm{proj}_K(s - \rho\tilde U)|/\max(|s|, |\rho q|)$ and its
 #    distance to the limit of the same iteration (same guess, same review order) run to
@@ -101,7 +102,8 @@ for j, state in enumerate(nl.state.values):
     for xkey, row in (("wall_time", 0), ("sweeps", 1)):
         ax = axes[row, j]
         for init in d.init.values:
-            for crit, style in (("residual", "-"), ("change", ":"), ("finish", "-."), ("anderson", (0, (5, 1, 1, 1, 1, 1)))):
+            for crit, style in (("residual", "-"), ("change", ":"), ("finish", "-."), ("anderson", (0, (5, 1, 1, 1, 1, 1))),
+                               ("anderson_local", (0, (1, 1)))):
                 if crit not in d.criterion.values:
                     continue
                 e = d.sel(init=init, criterion=crit)
@@ -207,7 +209,7 @@ total = 0
 for state in nl.state.values:
     for init in nl.init.values:
         for crit in nl.criterion.values:
-            if crit == "anderson":     # its limit need not be plain NLGS's in an indeterminate set
+            if crit in ("anderson", "anderson_local"):   # the limit need not be plain NLGS's in an indeterminate set
                 continue
             e = nl.sel(state=state, init=init, criterion=crit).sortby("tol", ascending=False)
             conv = e.converged.values.astype(bool)
@@ -233,18 +235,22 @@ for state in nl.state.values:      # cost of a decade of residual, and error per
                  f"{per_decade.min():.0f}–{per_decade.max():.0f} sweeps; the distance to the limit is "
                  f"{ratio_s.min():.2g}–{ratio_s.max():.2g} times the tolerance in impulses and "
                  f"{ratio_v.min():.2g}–{ratio_v.max():.2g} times in velocities (g h).")
-if "anderson" in nl.criterion.values:
-    tight = nl.tol.values.min()
-    a = nl.sel(tol=tight, criterion="anderson")
-    r = nl.sel(tol=tight, criterion="residual")
-    lines.append("* **Anderson-accelerated NLGS** (`ncd.anderson`) to the tightest tolerance "
-                 f"({tight:.0e}), zero guess: " + "; ".join(
-                     f"{st} {int(a.sweeps.sel(state=st, init='zero'))} sweeps against "
-                     f"{int(r.sweeps.sel(state=st, init='zero'))} plain, "
-                     f"{1e3 * float(a.wall_time.sel(state=st, init='zero')):.2g} ms against "
-                     f"{1e3 * float(r.wall_time.sel(state=st, init='zero')):.2g} ms, velocity distance to plain "
-                     f"NLGS's limit {float(a.error_velocity.sel(state=st, init='zero')):.1e} g h"
-                     for st in nl.state.values) + ".")
+tight = nl.tol.values.min()
+r = nl.sel(tol=tight, criterion="residual")
+for crit, label, inits, note in (
+        ("anderson", "Anderson-accelerated NLGS** (`ncd.anderson`)", ["zero"], ""),
+        ("anderson_local", "Anderson with local exact solves** (`ncd.local_exact`)", list(nl.init.values),
+         " Figure 2's step, where plain NLGS stalls from the warm guess, is in the benchmark suite (`bench.html`).")):
+    if crit not in nl.criterion.values:
+        continue
+    a = nl.sel(tol=tight, criterion=crit)
+    lines.append(f"* **{label} to the tightest tolerance ({tight:.0e}): " + "; ".join(
+        f"{st}, {init} guess: {int(a.sweeps.sel(state=st, init=init))} sweeps against "
+        f"{int(r.sweeps.sel(state=st, init=init))} plain, "
+        f"{1e3 * float(a.wall_time.sel(state=st, init=init)):.2g} ms against "
+        f"{1e3 * float(r.wall_time.sel(state=st, init=init)):.2g} ms, velocity distance to plain "
+        f"NLGS's limit {float(a.error_velocity.sel(state=st, init=init)):.1e} g h"
+        for st in nl.state.values for init in inits) + "." + note)
 tol_mid = nl.tol.values[np.argmin(np.abs(np.log10(nl.tol.values) + 6))]
 for state in nl.state.values:
     d = nl.sel(state=state, criterion="residual", tol=tol_mid)

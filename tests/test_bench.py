@@ -141,3 +141,25 @@ def test_tolerance_table_both_methods_reach_the_tolerance():
     # Anderson acceleration: fewer sweeps than plain NLGS to every tolerance on the dense packing
     assert (ds.sweeps.sel(solver="anderson").values < ds.sweeps.sel(solver="nlgs").values).all()
     assert ds.seconds.attrs["units"] == "s"
+
+
+def test_tolerance_problems_local_solves(results):
+    """The figures' problems side by side (issue 13): every run stopping as converged is at
+    or below its tolerance; plain NLGS is at distance 0 from itself; a run with local exact
+    solves enabled that made none is plain NLGS sweep for sweep (the chunks of the stall test
+    do not change the sweeps; Anderson's do: no extrapolation after a chunk's last sweep); the warm-started
+    Figure 2 step is there."""
+    path = results / "bench" / "tolerance_problems.nc"
+    if not path.exists():
+        pytest.skip(f"no {path} (run `snakemake -j2 bench`)")
+    ds = xr.load_dataset(path)
+    assert {"pile", "fig2_step", "fig2_step_warm"} <= set(ds.problem.values)
+    assert {"nlgs+local", "anderson+local"} <= set(ds.solver.values)
+    conv = ds.converged.values == 1
+    assert (ds.residual.values[conv] <= np.broadcast_to(ds.tol.values, ds.residual.shape)[conv] * (1 + 1e-12)).all()
+    assert (ds.gap_to_nlgs.sel(solver="nlgs").values == 0).all()
+    loc = ds.sel(solver="nlgs+local")
+    none = loc.local_solves.values == 0
+    assert np.array_equal(loc.sweeps.values[none], ds.sel(solver="nlgs").sweeps.values[none])
+    assert (ds.local_solves.sel(solver=["nlgs", "anderson", "nlgs+finish"]).values == 0).all()
+    assert ds.local_solves.attrs["units"] == "1" and ds.gap_to_nlgs.attrs["long_name"]

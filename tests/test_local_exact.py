@@ -138,3 +138,24 @@ def test_invalid_setting(value):
 def test_local_form_refuses_local_solves():
     with pytest.raises(ncd.InputError, match="local_exact"):
         ncd.solve_local(np.eye(2), np.array([-1.0, 0.0]), 0.5, settings=ncd.SolverSettings(local_exact=True))
+
+
+def test_chunked_runs_and_budget_end(step):
+    """With an observable (calls of ``check_every`` sweeps) the stall test still runs every
+    100 sweeps and the run finishes; a budget ending just after a stall returns a sweep's
+    output (the solve waits for the next sweeps): its residual is that of its velocities,
+    and its velocities those of its impulses."""
+    scene, problem, warm, order = step
+    gh = np.linalg.norm(scene.gravity) * problem.h
+    r, vel, spin = ncd.solve_problem(scene, problem, warm.copy(), order, ncd.SolverSettings(
+        tol=1e-10, max_sweeps=20000, check_every=10, local_exact=True), observe=lambda s, v, w: v[:, 0] / gh)
+    assert r.converged and r.local_solves >= 1 and r.observable_change <= 1e-6
+    W, Hm, minv = global_delassus(scene, problem.contacts)
+    nm = scene.n_mobile
+    free = np.column_stack([problem.free_vel[:nm], problem.free_spin[:nm]]).ravel()
+    for budget in (2500, 2600, 2700):
+        r, vel, spin = ncd.solve_problem(scene, problem, warm.copy(), order, ncd.SolverSettings(
+            tol=1e-14, max_sweeps=budget, check_every=10, local_exact=True, keep_best=False))
+        assert _residual(problem, r.impulse, vel, spin) == pytest.approx(r.residual, rel=1e-6)
+        u = np.column_stack([vel[:nm], spin[:nm]]).ravel()
+        assert np.abs(u - free - minv * (Hm @ r.impulse.ravel())).max() < 1e-13 * np.abs(u).max()   # round-off

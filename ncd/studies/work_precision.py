@@ -73,7 +73,8 @@ def nlgs_work_precision(s, h, tols, inits, criteria, reference, repeats, max_swe
     Criterion ``"finish"``: NLGS to ``max(tol, FINISH_HANDOFF)``, then the finishing stage
     (:mod:`ncd.finish`: NLGS while its rate is good, else the projection on its statuses'
     polyhedron) to ``tol``.  Criterion ``"anderson"``: Anderson-accelerated NLGS
-    (:mod:`ncd.anderson`, memory :data:`ANDERSON_MEMORY`) to ``tol`` on the residual."""
+    (:mod:`ncd.anderson`, memory :data:`ANDERSON_MEMORY`) to ``tol`` on the residual;
+    ``"anderson_local"``: the same with local exact solves where it stalls (:mod:`ncd.local_exact`)."""
     problem = prepare_step(s, h)
     guesses = {init: initial_guess(s, problem, init) for init in inits}
     ref_settings = SolverSettings(tol=reference["tol"], max_sweeps=reference["max_sweeps"])
@@ -89,7 +90,8 @@ def nlgs_work_precision(s, h, tols, inits, criteria, reference, repeats, max_swe
                 settings = (SolverSettings(tol=max(tol, FINISH_HANDOFF), max_sweeps=max_sweeps, finish="active_set",
                                            finish_tol=tol) if crit == "finish"
                             else SolverSettings(tol=tol, max_sweeps=max_sweeps, accel="anderson",
-                                                accel_memory=ANDERSON_MEMORY) if crit == "anderson"
+                                                accel_memory=ANDERSON_MEMORY, local_exact=crit == "anderson_local")
+                            if crit in ("anderson", "anderson_local")
                             else SolverSettings(tol=tol, max_sweeps=max_sweeps, criterion=crit))
                 best = np.inf
                 for _ in range(repeats):

@@ -2,8 +2,9 @@
 #   core      ns per contact update (numba and the same loop in C), detection,
 #             time per step and memory on dense packings       -> results/bench/core.nc
 #   sweeps    sweeps to a fixed tolerance against N             -> results/bench/sweeps.nc
-#   tolerance time to 1e-6/1e-8/1e-10, NLGS and NLGS + finish -> results/bench/tolerance.nc
-#             (dense packings), tolerance_problems.nc (the pile's final state, fig2's step)
+#   tolerance time to 1e-6/1e-8/1e-10, NLGS, NLGS + finish, Anderson, and local exact
+#             solves -> results/bench/tolerance.nc (dense packings), tolerance_problems.nc
+#             (the pile's final state, fig2's step from the zero and the warm guess)
 #   ensemble  NLGS ensemble on 1 and 2 threads                  -> results/bench/ensemble.nc
 #   peer      ncd and pymunk side by side on a poured pile      -> results/bench/peer.nc
 #   rules     wall time of every rule of the figures' run       -> results/bench/rules.nc
