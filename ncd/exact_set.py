@@ -116,7 +116,7 @@ class ExactSet:
         """Exact range of ``phi = atan2(-g_y, outer g_x)`` over ``g = L r``, r in A ∩ C
         (degrees): the angle below the horizontal, pointing outward, of a cut resultant.
 
-        Around a reference direction ``phi0`` (``ref``; default: an LP point), with
+        Around a reference direction ``phi0`` (``ref``; default, or NaN: an LP point), with
         ``p = a . u``, ``q = b . u`` (``u = (outer g_x, -g_y)``, ``a`` along ``phi0``, ``b``
         normal to it), ``tan(phi - phi0) = q / p``.  One LP certifies ``p > 0`` on all of
         A ∩ C (the image lies in an open half-plane, so its angles span less than 180°);
@@ -134,7 +134,7 @@ class ExactSet:
         M = sp.diags([float(outer), -1.0]) @ L          # r -> u = (outer g_x, -g_y)
         Mt = M.T.tocsr()
         n0 = self.n_lp
-        if ref is None:
+        if ref is None or not np.isfinite(ref):
             u = M @ self.minimize(np.zeros(L.shape[1]))[1]
             ref = np.degrees(np.arctan2(u[1], u[0]))
         t = np.radians(ref)

@@ -23,7 +23,7 @@ those of :mod:`ncd.nlgs` (the returned iterate is a sweep's output).
 
 Measured on Figure 2's step 50 (552 contacts) from the previous step's impulses, to
 1e-10 (the benchmark ``bench_tolerance``, identity and 2 random review orders): plain NLGS
-150,930-165,130 sweeps, 0.94 s; with local solves 8,870-9,970 sweeps, 0.059-0.064 s; with
+150,930-165,130 sweeps, 0.91-0.96 s; with local solves 8,870-9,970 sweeps, 0.058-0.063 s; with
 Anderson and local solves 1,600-2,130 sweeps, 0.022-0.028 s; both on plain NLGS's own
 solution (end-of-step velocities within 7e-7 |g| h).  Seeding the region with the largest
 natural-map residuals instead of the drift left one of six orders on its plateau (the

@@ -306,6 +306,21 @@ def test_empty_cuts_are_left_out_of_the_arching_statistics(analysis):
     assert np.isfinite(analysis.deviation_median_lo.values).sum() == np.isfinite(med).sum()
 
 
+def test_exact_files_give_no_direction_to_empty_cuts(analysis, results):
+    """The per-pile exact files store the history angle through ``cuts.flank_angles``:
+    NaN exactly where the analysis counts no contact crossing the cut (an empty cut once
+    stored -180 degrees), with no exact range and no distance outside it."""
+    cfg = yaml.safe_load(analysis.attrs["config_yaml"])
+    files = sorted((results / "fig4_history" / "exact" / f"n{cfg['grains']['n']}").glob("*.nc"))
+    assert len(files) == 2 * min(cfg["exact"]["piles"], cfg["piles"])
+    for f in files:
+        e = xr.load_dataset(f)
+        count = analysis.cut_count.sel(history=e.attrs["history"], pile=int(e.attrs["member"])).values
+        empty = np.isnan(e.history_angle.values)
+        assert np.array_equal(empty, count == 0), f.name
+        assert np.isnan(e.exact_angle_min.values[empty]).all() and np.isnan(e.history_outside.values[empty]).all()
+
+
 # ------------------------------------------------------------------ size study
 @pytest.fixture(scope="module")
 def size(results):

@@ -188,7 +188,8 @@ def test_angle_range_equals_the_angles_of_the_enumerated_vertices(outer):
     """ExactSet.angle_range (Dinkelbach's iteration, a few LPs) against brute force: the
     angle range of the enumerated vertices of a three-grain pile's A ∩ C under the left
     ground disc's force, whatever the reference direction (the vertices' own angles, a
-    direction 100 degrees off that does not separate the image from 0, none)."""
+    direction 100 degrees off that does not separate the image from 0, none, NaN: the
+    history angle of a cut crossing no contact)."""
     scene = three_grain_pile(0.3)
     c, H, F = balanced(scene)
     V = vertices_by_enumeration(H, F, c.mu)
@@ -200,7 +201,7 @@ def test_angle_range_equals_the_angles_of_the_enumerated_vertices(outer):
     P = V @ L.T
     phi = np.degrees(np.arctan2(-P[:, 1], outer * P[:, 0]))
     assert phi.max() - phi.min() > 5.0                       # a range worth testing
-    for ref in (float(phi.mean()), float(phi.mean()) + 100.0, None):
+    for ref in (float(phi.mean()), float(phi.mean()) + 100.0, None, float("nan")):
         r = es.angle_range(L, outer, ref=ref)
         assert abs(r["lo"] - phi.min()) <= 1e-8 and abs(r["hi"] - phi.max()) <= 1e-8
         assert r["bound"] <= 1e-8 and r["n_lp"] <= 30
@@ -230,3 +231,5 @@ def test_angle_range_is_undefined_when_the_image_surrounds_zero():
         else:
             assert abs(r["lo"] - ref[0]) <= 1e-8 and abs(r["hi"] - ref[1]) <= 1e-8
     assert seen[True] >= 2 and seen[False] >= 2
+    r = es.angle_range(np.zeros((2, 2 * c.n)), 1, ref=float("nan"))      # a cut crossing no contact
+    assert np.isnan(r["lo"]) and np.isnan(r["hi"])

@@ -42,7 +42,7 @@ def exact_ranges(cfg, ds, log=None):
     specs, outer, slope = cut_specs(cfg, ds)
     C, _ = cm.cut_matrix(c, scene.pos, nm, specs)
     hist = (C @ np.column_stack([ds["force_n"].values, ds["force_t"].values]).ravel()).reshape(-1, 2)
-    phi_hist = np.degrees(np.arctan2(-hist[:, 1], outer * hist[:, 0]))
+    phi_hist = cm.flank_angles(hist[:, 0], hist[:, 1], outer, 0.0)[0]     # NaN: a cut crossing no contact
     amin, amax, bound, n_lp, fy_max = [], [], [], [], []
     for k in range(len(specs)):
         n0 = es.n_lp

@@ -76,7 +76,7 @@ def exact_dataset(cfg, construction, cuts, log=None):
     C, _ = cm.cut_matrix(c, scene.pos, nm, _cut_specs(cuts))
     kind, outer = cuts["kind"].values, cuts["outer"].values
     hist_F = (C @ history).reshape(-1, 2)
-    hist_angle = np.degrees(np.arctan2(-hist_F[:, 1], outer * hist_F[:, 0]))
+    hist_angle = cm.flank_angles(hist_F[:, 0], hist_F[:, 1], outer, 0.0)[0]     # NaN: a cut crossing no contact
     # (a) the polygons of the default and shifted cuts
     polys, n_lp, exact, walls = [], [], [], []
     for k in np.nonzero(kind != "scan")[0]:
