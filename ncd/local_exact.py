@@ -49,17 +49,31 @@ def solve_region(W, q, mu, s, idx):
     :func:`ncd.lcp.frictional_lcp` on ``W_RR`` and ``q_R = q_R + W_R,other s_other``,
     by Lemke's method, in units where ``q_R`` and the diagonal of ``W_RR`` are of order one
     (the law is invariant under a scaling of impulses and of velocities).  None when Lemke
-    gives no solution."""
+    gives no solution (or ``q_R`` is not finite)."""
     dof = np.column_stack([2 * idx, 2 * idx + 1]).ravel()
-    Wrr = W[dof][:, dof].toarray()
-    q_r = (W[dof] @ s + q[dof]) - Wrr @ s[dof]
+    rows = W[dof]
+    Wrr = rows[:, dof].toarray()
+    q_r = (rows @ s + q[dof]) - Wrr @ s[dof]
     V = float(np.abs(q_r).max())
-    if not V > 0:
+    if not np.isfinite(V):
+        return None
+    if V == 0.0:
         return np.zeros((len(idx), 2))
     S = V / float(Wrr.diagonal().max())
     A, b = frictional_lcp(Wrr * (S / V), q_r / V, mu[idx])
     z, _ = lemke(A, b)
     return None if z is None else S * impulse_of_lcp(z, mu[idx])
+
+
+def region(moved, body_a, body_b, n_mobile):
+    """Contacts of a region: the :data:`SEED` contacts of largest ``moved`` and the other
+    contacts of their mobile grains (at most :data:`MAX_REGION`, those of largest ``moved``)."""
+    seed = np.argsort(-moved, kind="stable")[:SEED]
+    grains = np.concatenate([body_a[seed], body_b[seed]])
+    grains = grains[grains < n_mobile]
+    near = np.flatnonzero(np.isin(body_a, grains) | np.isin(body_b, grains))
+    near = near[np.argsort(-moved[near], kind="stable")][:MAX_REGION]
+    return np.union1d(seed, near)
 
 
 class LocalExact:
@@ -77,31 +91,20 @@ class LocalExact:
         self.free = free                                        # u_free of the mobile grains (3 nm,)
         self.reset = reset
         self.solves = 0
-        self.failed = 0
-
-    def region(self, moved):
-        """Contacts of the region: the seed (largest ``moved``) and its grains' other contacts."""
-        seed = np.argsort(-moved, kind="stable")[:SEED]
-        grains = np.concatenate([self.a[seed], self.b[seed]])
-        grains = grains[grains < self.nm]
-        near = np.flatnonzero(np.isin(self.a, grains) | np.isin(self.b, grains))
-        near = near[np.argsort(-moved[near], kind="stable")][:MAX_REGION]
-        return np.union1d(seed, near)
 
     def solve(self, moved):
-        """Solve the region of ``moved`` exactly, the other impulses frozen; True if done."""
-        idx = self.region(moved)
+        """Solve the region of ``moved`` exactly, the other impulses frozen (nothing when
+        Lemke gives no solution)."""
+        idx = region(moved, self.a, self.b, self.nm)
         s_region = solve_region(self.W, self.q, self.mu, self.imp, idx)
         if s_region is None:
-            self.failed += 1
-            return False
+            return
         self.solves += 1
         s = self.imp
         s.reshape(-1, 2)[idx] = s_region
         self.body[:self.nm, :3] = (self.free + self.minv * (self.H @ s)).reshape(self.nm, 3)
         if self.reset is not None:
             self.reset()
-        return True
 
     def driver(self, iterate):
         """A callable with the signature of :func:`ncd.nlgs._iterate_discs`: ``iterate``
@@ -109,15 +112,14 @@ class LocalExact:
         :data:`CHUNK` sweeps (across calls: the chunked runs of :mod:`ncd.convergence`
         call it ``check_every`` sweeps at a time), a local exact solve after a stall.
         The solve is made before the next sweeps, never as a call's last act: the
-        iterate a call returns is always a sweep's output."""
-        from .nlgs import _residual_discs
+        iterate a call returns is always a sweep's output.  The residual of a chunk is the one
+        ``iterate`` returns: it checks at its last sweep."""
         history = []
         period = {"start": None, "since": 0, "pending": None}
 
         def run(data, order, status, scale, tol, max_sweeps, criterion, check_every, best):
             done = 0
             res, change, ok = np.inf, np.inf, False
-            keep, keep_imp, keep_status, keep_body, k0 = best
             while done < max_sweeps and not ok:
                 if period["pending"] is not None:
                     self.solve(period["pending"])
@@ -126,13 +128,12 @@ class LocalExact:
                     period["start"] = self.imp.copy()
                 k, res, change, ok = iterate(data, order, status, scale, tol,
                                              min(CHUNK - period["since"], max_sweeps - done), criterion,
-                                             check_every, (keep, keep_imp, keep_status, keep_body, k0 + done))
+                                             check_every, best[:4] + (best[4] + done,))
                 done += int(k)
                 period["since"] += int(k)
                 if ok or period["since"] < CHUNK:
                     continue
-                rsq, ssq = _residual_discs(data)
-                history.append(np.sqrt(rsq) / max(scale, np.sqrt(ssq), 1e-300))
+                history.append(res)
                 if len(history) > STALL_WINDOW and history[-1] > STALL_FACTOR * history[-1 - STALL_WINDOW]:
                     period["pending"] = np.abs(self.imp - period["start"]).reshape(-1, 2).sum(axis=1)
                     history.clear()

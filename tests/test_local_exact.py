@@ -91,10 +91,8 @@ def test_region_solve_is_exact_there_and_leaves_the_rest(step):
     W, _, _ = global_delassus(scene, c)
     W = W.tocsr()
     q = _velocities(problem, problem.free_vel, problem.free_spin).ravel()    # U = W s + q
-    ex = local_exact.LocalExact.__new__(local_exact.LocalExact)
-    ex.a, ex.b, ex.nm = c.body_a, c.body_b, scene.n_mobile
     moved = np.abs(r.impulse).sum(axis=1) * np.random.default_rng(0).random(c.n)
-    idx = ex.region(moved)
+    idx = local_exact.region(moved, c.body_a, c.body_b, scene.n_mobile)
     assert local_exact.SEED <= len(idx) <= local_exact.SEED + local_exact.MAX_REGION
     s = r.impulse.ravel().copy()
     s_region = local_exact.solve_region(W, q, c.mu, s, idx)

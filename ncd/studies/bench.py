@@ -36,6 +36,7 @@ import xarray as xr
 from .. import nlgs
 from ..contacts import detect_contacts
 from ..explore import explore
+from ..finish_bench import settings_of
 from ..nlgs import SolverSettings
 from ..scene import make_scene
 from ..stepper import initial_guess, prepare_step, solve_problem, step
@@ -262,14 +263,7 @@ def tolerance_table(cfg, log=None):
         solve_problem(scene, problem, settings=SolverSettings(tol=1.0, max_sweeps=1))    # warm-up
         for j, method in enumerate(methods):
             for k, tol in enumerate(tols):
-                if method == "nlgs":
-                    settings = SolverSettings(tol=tol, max_sweeps=cfg["max_sweeps"], check_every=10)
-                elif method == "anderson":
-                    settings = SolverSettings(tol=tol, max_sweeps=cfg["max_sweeps"], check_every=10, accel="anderson",
-                                              accel_memory=20)
-                else:
-                    settings = SolverSettings(tol=max(tol, cfg["handoff"]), max_sweeps=cfg["max_sweeps"],
-                                              check_every=10, finish="active_set", finish_tol=tol)
+                settings = settings_of(method, tol, cfg["handoff"], cfg["max_sweeps"], 10)
                 t0 = time.perf_counter()
                 r, _, _ = solve_problem(scene, problem, settings=settings)
                 out["seconds"][i, j, k] = time.perf_counter() - t0
