@@ -24,9 +24,9 @@ include: "workflow/rules/html.smk"
 
 # A run killed with SIGKILL leaves its locks: remove them (and stray *.part files) when no
 # Snakemake process or job still runs here, so that a plain rerun needs no --unlock; its
-# unfinished jobs are rerun by profiles/default (rerun-incomplete).  See ncd.pipeline.
+# unfinished jobs are rerun by profiles/default (rerun-incomplete).  See ncd.pipeline.workflow.
 if workflow.is_main_process and not workflow.dryrun:
-    from ncd.pipeline import recover_killed_run
+    from ncd.pipeline.workflow import recover_killed_run
 
     recover_killed_run(".", logger=lambda m: print(m, file=sys.stderr))
 

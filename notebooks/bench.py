@@ -37,7 +37,7 @@
 # * `sweeps.nc`: the sweeps needed to reach a fixed natural-map residual on one
 #   step, from the zero guess and from the warm start;
 # * `ensemble.nc`: one ensemble of zero-guess NLGS runs with random review
-#   orders on 1 and 2 threads (`ncd.explore.run_parallel`): speed-up and a digest
+#   orders on 1 and 2 threads (`ncd.dynamics.explore.run_parallel`): speed-up and a digest
 #   of every result, which must be the same;
 # * `peer.nc`: a pile poured from a point source, the same scene in ncd and in
 #   pymunk (Chipmunk2D, C, sequential impulses) with the same number of
@@ -46,16 +46,17 @@
 #   `benchmark:` files.
 
 # %%
+import matplotlib
 import numpy as np
 import pandas as pd
 import xarray as xr
 import yaml
-import matplotlib
+
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
-from IPython.display import display, Markdown
+from IPython.display import Markdown, display
 
-from ncd.notebook import paths, save
+from ncd.pages.notebook import paths, save
 
 # Snakemake's object, or by hand (from the repository or notebooks/) the files under results/
 snakemake = paths("bench", ["core", "sweeps", "tolerance", "tolerance_problems", "ensemble", "peer", "rules"], globals().get("snakemake"))
@@ -184,10 +185,10 @@ display(Markdown(
 # ## Time to tolerance: plain NLGS, NLGS + finishing stage, Anderson-accelerated NLGS
 #
 # One step from rest of each dense packing, zero guess: plain NLGS run to each tolerance,
-# NLGS followed by the finishing stage (`ncd.finish`: when NLGS's own rate predicts the
+# NLGS followed by the finishing stage (`ncd.solver.finish`: when NLGS's own rate predicts the
 # tolerance beyond its budget, the iterate is projected by LP onto the solutions sharing its
 # contact statuses, or, when there are none, onto the states at rest), and
-# Anderson-accelerated NLGS (`ncd.anderson`), to the same tolerance.
+# Anderson-accelerated NLGS (`ncd.solver.anderson`), to the same tolerance.
 
 # %%
 tt = tol_ds.to_dataframe().reset_index()
@@ -213,7 +214,7 @@ display(Markdown("Runs reaching each tolerance: " + "; ".join(
 
 
 # %% [markdown]
-# **Local exact solves** (`ncd.local_exact`, methods `nlgs+local` and `anderson+local`):
+# **Local exact solves** (`ncd.solver.local_exact`, methods `nlgs+local` and `anderson+local`):
 # where the residual stops falling, the contacts that drift most and the other contacts of
 # their grains are solved exactly by Lemke's method, the other impulses frozen, and the
 # sweeps go on. Speed-up over plain NLGS at the tightest tolerance, per problem (min–max

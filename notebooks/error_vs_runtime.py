@@ -33,10 +33,10 @@
 #    a small settled pile on a rough floor, and a step of a periodic slope flow at 24°
 #    (their sizes are in the verdicts below) — every setting (initial guess zero or warm,
 #    stopping criterion natural-map residual or impulse change, or NLGS with the finishing
-#    stage of `ncd.finish` (criterion `finish`: NLGS to $10^{-4}$, then, where NLGS's rate
+#    stage of `ncd.solver.finish` (criterion `finish`: NLGS to $10^{-4}$, then, where NLGS's rate
 #    is slow, the projection on the polyhedron of its contact statuses), or Anderson-accelerated
-#    NLGS (criterion `anderson`, `ncd.anderson`), or the same with local exact solves where
-#    it stalls (criterion `anderson_local`, `ncd.local_exact`), tolerance) gives one
+#    NLGS (criterion `anderson`, `ncd.solver.anderson`), or the same with local exact solves where
+#    it stalls (criterion `anderson_local`, `ncd.solver.local_exact`), tolerance) gives one
 #    point: its wall time (best of a few repeats), its sweeps, its relative natural-map
 #    residual $|s - \mathrm{proj}_K(s - \rho\tilde U)|/\max(|s|, |\rho q|)$ and its
 #    distance to the limit of the same iteration (same guess, same review order) run to
@@ -45,7 +45,7 @@
 #    this target builds only its own inputs.  They are small stand-ins of the paper's
 #    states (a packing, a pile, a slope step), not their configurations or sizes.
 # 2. *Time integration.*  An observable with a known or reference value, against wall
-#    time, for CD over $h$ and for MD (`ncd.md`) over $h = f\,h_\mathrm{crit}$ and stiffness
+#    time, for CD over $h$ and for MD (`ncd.dynamics.md`) over $h = f\,h_\mathrm{crit}$ and stiffness
 #    $k = c\,k_0$ ($k_0$: overlap of 1 % of a radius under the load):
 #    the distance travelled on an incline from rest (closed form: sliding
 #    $a = g(\sin\alpha - \mu\cos\alpha)$, rolling $a = \tfrac23 g\sin\alpha$); a settled
@@ -54,16 +54,17 @@
 #    tolerance (and CD at half that step, to measure the reference's own uncertainty).
 
 # %%
+import matplotlib
 import numpy as np
 import pandas as pd
 import xarray as xr
-import matplotlib
+
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import matplotlib.ticker
-from IPython.display import display, Markdown
+from IPython.display import Markdown, display
 
-from ncd.notebook import paths, save
+from ncd.pages.notebook import paths, save
 
 # Snakemake's object, or by hand (from the repository or notebooks/) the files under results/
 snakemake = paths("error_vs_runtime", ["nlgs", "integration"], globals().get("snakemake"))
@@ -238,8 +239,8 @@ for state in nl.state.values:      # cost of a decade of residual, and error per
 tight = nl.tol.values.min()
 r = nl.sel(tol=tight, criterion="residual")
 for crit, label, inits, note in (
-        ("anderson", "Anderson-accelerated NLGS** (`ncd.anderson`)", ["zero"], ""),
-        ("anderson_local", "Anderson with local exact solves** (`ncd.local_exact`)", list(nl.init.values),
+        ("anderson", "Anderson-accelerated NLGS** (`ncd.solver.anderson`)", ["zero"], ""),
+        ("anderson_local", "Anderson with local exact solves** (`ncd.solver.local_exact`)", list(nl.init.values),
          " Figure 2's step, where plain NLGS stalls from the warm guess, is in the benchmark suite (`bench.html`).")):
     if crit not in nl.criterion.values:
         continue

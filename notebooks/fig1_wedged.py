@@ -51,8 +51,8 @@ import yaml
 from IPython.display import Image, Markdown, display
 
 from ncd.figures.wedged import Wedge
-
-from ncd.notebook import paths as notebook_paths, save
+from ncd.pages.notebook import paths as notebook_paths
+from ncd.pages.notebook import save
 
 # Snakemake's object, or by hand (from the repository or notebooks/) the files under results/
 _smk = notebook_paths("fig1_wedged", ["ensemble", "evolutions", "sweep"], globals().get("snakemake"))
@@ -124,7 +124,7 @@ print(f"contact normals {beta:.2f} deg below the horizontal; mu = {wedge.mu} "
 #
 # `ncd.figures.wedged.Wedge` implements these formulas; `tests/test_fig1_wedged.py`
 # checks them against a linear program on the equilibrium equations
-# $H\rho + F = 0$ built by `ncd.contacts.h_matrix`.
+# $H\rho + F = 0$ built by `ncd.core.contacts.h_matrix`.
 
 # %%
 print(f"threshold: gamma > beta = {beta:.2f} deg; here gamma = {gamma:.2f} deg -> wedging "

@@ -29,7 +29,7 @@
 # be determinant".
 #
 # **What we compute.** The scene is built, deposited and released by
-# `ncd.figures.slope`: polydisperse discs (diameters uniform, $d_{max}/d_{min}$
+# `ncd.scenes.slope`: polydisperse discs (diameters uniform, $d_{max}/d_{min}$
 # stated below) on a rough ground made of a row of touching *glued discs*
 # (fixed obstacle discs) of the mean diameter, periodic along the ground. A
 # flat frictional wall was not used: the bottom layer could then roll on a
@@ -51,16 +51,14 @@
 import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
+from IPython.display import Markdown
 from matplotlib.collections import LineCollection, PatchCollection
 from matplotlib.colors import LogNorm
 from matplotlib.patches import Circle
 
-from IPython.display import Markdown
-
 from ncd.figures import census as cs
-from ncd.figures import slope_analysis as sa
-
-from ncd.notebook import paths, save
+from ncd.pages.notebook import paths, save
+from ncd.scenes import slope_analysis as sa
 
 # Snakemake's object, or by hand (from the repository or notebooks/) the files under results/
 _smk = paths("fig2_slope", ["trajectory", "ensemble", "measures", "census"], globals().get("snakemake"))
@@ -413,7 +411,7 @@ save(fig, out, dpi=150)
 
 # %%
 census = xr.load_dataset(inp.census)
-cloud = cs.cloud_against_census(ens, census, grain, "zero")
+cloud = sa.cloud_against_census(ens, census, grain, "zero")
 Markdown(cs.census_text(census) + "\n\n**The chosen grain's cloud, read through the census.** "
          + cs.cloud_text(cloud, grain, tight, an["line_ratio"]))
 
@@ -437,7 +435,7 @@ scan_text = ""
 if len(scan):
     none = {init: int((traj[f"scan_{init}_converged"].values == 0).sum()) for init in ("zero", "warm")}
     several = {init: traj[f"scan_{init}_solutions"].values > 1 for init in ("zero", "warm")}
-    n_scan = len(traj[f"scan_zero_solutions"])
+    n_scan = len(traj["scan_zero_solutions"])
     scan_text = (f" In the scan of the flow ({n_scan} steps, {cfg['scan']['runs']} runs each), no zero-guess run "
                  f"converged at {none['zero']} steps and no warm run at {none['warm']}; several solutions appear at "
                  f"{int(several['zero'].sum())} steps from the zero guess and at {int(several['warm'].sum())} from "

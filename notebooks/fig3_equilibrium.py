@@ -47,15 +47,13 @@
 import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
+from IPython.display import Markdown
 from matplotlib.patches import Circle
 
-from IPython.display import Markdown
-
+from ncd.exact.polygon import outside_distance
 from ncd.figures import equilibrium as fe
 from ncd.figures import faces
-from ncd.polytope import outside_distance
-
-from ncd.notebook import paths, save
+from ncd.pages.notebook import paths, save
 
 # Snakemake's object, or by hand (from the repository or notebooks/) the files under results/
 _smk = paths("fig3_equilibrium", ["state", "ensemble", "projection", "uniform"], globals().get("snakemake"))

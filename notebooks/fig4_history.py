@@ -57,8 +57,8 @@ try:
     snakemake  # noqa: F821 (injected by Snakemake's notebook directive)
     inp, out, cfg = snakemake.input, snakemake.output, snakemake.params.config  # noqa: F821
 except NameError:  # by hand, from the repository root after `snakemake -j2 fig4_history`
-    import glob
     from types import SimpleNamespace
+
     import yaml
     cfg = yaml.safe_load(open("config.yaml"))["fig4_history"]
     n = cfg["grains"]["n"]

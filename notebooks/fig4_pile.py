@@ -63,11 +63,11 @@
 #    every cut, the ground force and pressure, and the end-of-step velocities'
 #    summary (a run whose grains do not all stay at rest is not an equilibrium).
 #    With `ensemble.finish: active_set` (the default) NLGS hands each run over
-#    at the ensemble's tolerance to the finishing stage (`ncd.finish`): the
+#    at the ensemble's tolerance to the finishing stage (`ncd.solver.finish`): the
 #    iterate is projected (L1, an LP) on the one-step solutions sharing its
 #    contact statuses, or else on the states at rest, and the projection is
 #    kept only if it is an exact solution close to the iterate (relative L1
-#    move at most `ncd.finish.MAX_CORRECTION`). A run then
+#    move at most `ncd.solver.finish.MAX_CORRECTION`). A run then
 #    ends on an exact solution, at rest or with grains moving, and is
 #    classified; only rest runs enter the clouds.
 #    *Tolerance study* (`tolerance.nc`): the first members again (same review
@@ -82,18 +82,16 @@
 import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
+from IPython.display import Markdown
 from matplotlib.collections import LineCollection, PatchCollection
 from matplotlib.gridspec import GridSpec
 from matplotlib.patches import Circle
 
-from IPython.display import Markdown
-
-from ncd.figures import cuts as cm
 from ncd.figures import pile_exact as pe
 from ncd.figures.pile_exact import diameter
-from ncd.figures import pressure as pm
-
-from ncd.notebook import paths, save
+from ncd.pages.notebook import paths, save
+from ncd.scenes import cuts as cm
+from ncd.scenes import pressure as pm
 
 # Snakemake's object, or by hand (from the repository or notebooks/) the files under results/
 _smk = paths("fig4_pile", ["construction", "cuts", "ensemble", "tolerance", "exact"], globals().get("snakemake"))
@@ -109,7 +107,7 @@ W = cuts.attrs["weight"]
 kind = list(cuts.kind.values)
 K, KM, KP = kind.index("default"), kind.index("minus"), kind.index("plus")
 HIST = np.column_stack([cuts.history_fx.values, cuts.history_fy.values])
-conv = pe.rest_mask(ens)          # clouds: runs converged at rest only (ncd.convergence.classify)
+conv = pe.rest_mask(ens)          # clouds: runs converged at rest only (ncd.solver.convergence.classify)
 
 
 def cloud(ds, k, mask=None):

@@ -64,16 +64,14 @@
 # sticking and sliding equations).
 
 # %%
-import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
 from IPython.display import Markdown, display
 
 from ncd.figures import governing as fg
 from ncd.figures import governing_plot as gp
-from ncd.notebook import paths, save
-
 from ncd.figures import governing_summary as gs
+from ncd.pages.notebook import paths, save
 
 _smk = paths("fig5_governing", ["packings", "flows"], globals().get("snakemake"))
 inp, out, cfg = _smk.input, _smk.output, _smk.params.config
@@ -156,8 +154,8 @@ display(Markdown(
     f"Built-in differences: a body-force load (stress growing with depth) instead of a lid, the whole "
     f"packing instead of a bulk slice with fixed boundary forces, and {int(te[:, 3].min())}–{int(te[:, 3].max())} "
     f"packings per μ in this run"
-    + (f"; with fewer than 3 packings at some μ the location of the largest mean is not resolved "
-       f"(the seed bands of the figure)." if int(te[:, 3].min()) < 3 else ".")))
+    + ("; with fewer than 3 packings at some μ the location of the largest mean is not resolved "
+       "(the seed bands of the figure)." if int(te[:, 3].min()) < 3 else ".")))
 
 # %% [markdown]
 # ## Flows: indeterminate steps against friction, time step and slope

@@ -32,7 +32,7 @@
 #
 # * CD (`ncd.step`: $\theta = 1/2$, warm-started NLGS, tolerance and sweep budget in
 #   `config.yaml`, section `stability`) at each step $h$ of the case, and
-# * the MD baseline `ncd.md` (Cundall–Strack: linear spring–dashpot normal force,
+# * the MD baseline `ncd.dynamics.md` (Cundall–Strack: linear spring–dashpot normal force,
 #   tangential spring with a Coulomb slider, symplectic Euler) at
 #   $h = f\,h_\mathrm{crit}$, $h_\mathrm{crit} = 2/\omega$, $\omega = \sqrt{k_n/m_\mathrm{min}}$.
 #   The stiffness $k_n$ gives an overlap of 1 % of a radius under the case's load
@@ -55,15 +55,16 @@
 # **stable** = not diverged and energy growth $\le$ 5 % of $E_s$.
 
 # %%
+import matplotlib
 import numpy as np
 import pandas as pd
 import xarray as xr
-import matplotlib
+
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
-from IPython.display import display, Markdown
+from IPython.display import Markdown, display
 
-from ncd.notebook import paths, save
+from ncd.pages.notebook import paths, save
 
 # Snakemake's object, or by hand (from the repository or notebooks/) the files under results/
 snakemake = paths("stability", ["table"], globals().get("snakemake"))

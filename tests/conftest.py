@@ -61,3 +61,17 @@ def results(request):
     if os.environ.get("NCD_RESULTS_DIR"):
         return Path(os.environ["NCD_RESULTS_DIR"]) / "results"
     return request.getfixturevalue("dag_repo") / "results"
+
+
+DAG_FIXTURES = {"dag_repo", "results", "fresh_repo"}
+
+
+def pytest_collection_modifyitems(config, items):
+    """Mark ``pipeline`` every test that needs the reduced DAG, full-size data or a
+    Snakemake run of its own (a fixture of DAG_FIXTURES, or a call of run_snakemake or
+    copy_workflow), so that ``pytest -m "not pipeline"`` runs the unit tests alone."""
+    for item in items:
+        names = getattr(getattr(item, "function", None), "__code__", None)
+        calls = set(names.co_names) if names is not None else set()
+        if DAG_FIXTURES & set(getattr(item, "fixturenames", ())) or {"run_snakemake", "copy_workflow"} & calls:
+            item.add_marker(pytest.mark.pipeline)

@@ -9,7 +9,6 @@ scene or problem fields.  Sweep budgets stay below 300.
 """
 import numpy as np
 
-
 # ------------------------------------------------------------------ generators
 BAD_SCALARS = [np.nan, np.inf, -np.inf, -1.0, 0.0, -0.0, 1e308, -1e308, 1e-308, 1e300, -1e-300, 1.5, 2,
                True, None, "0.5", [0.5], np.array([1.0, 2.0]), 1 + 1j, np.float32(0.3), np.int64(3), 10**30]
@@ -147,7 +146,7 @@ def call(entry, rng):
     import scipy.sparse as sp
 
     import ncd
-    from ncd.explore import explore
+    from ncd.dynamics.explore import explore
     bad = rng.random(3) < 0.4             # which argument groups to spoil
     if entry == "make_scene":
         kw = scene_kwargs(rng)

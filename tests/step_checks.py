@@ -2,8 +2,8 @@
 solved step, recomputed from its end-of-step velocities (independently of the solver's own)."""
 import numpy as np
 
-from ncd import finish
-from ncd.contacts import local_velocity
+from ncd.core.contacts import local_velocity
+from ncd.solver import finish
 
 
 def contact_velocities(problem, vel, spin):
@@ -13,7 +13,7 @@ def contact_velocities(problem, vel, spin):
 
 
 def step_residual(problem, impulse, vel, spin):
-    """The relative natural-map residual of :mod:`ncd.nlgs` from the end-of-step velocities."""
+    """The relative natural-map residual of :mod:`ncd.solver.nlgs` from the end-of-step velocities."""
     rho = 1.0 / problem.W[:, 0, 0]
     q = contact_velocities(problem, problem.free_vel, problem.free_spin)
     return finish.relative_residual(impulse, contact_velocities(problem, vel, spin), problem.contacts.mu, rho,

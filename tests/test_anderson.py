@@ -1,14 +1,14 @@
 """Anderson-accelerated NLGS (issue 13 item 2, ``SolverSettings(accel="anderson")``)."""
 import numpy as np
 import pytest
-
-import ncd
-from ncd import convergence, finish
-from ncd.finish import check_solution
-from ncd.studies import scenes
-from ncd.studies.bench import dense_packing
 from step_checks import contact_velocities as _velocities
 from step_checks import step_residual as _residual
+
+import ncd
+from ncd.solver import convergence, finish
+from ncd.solver.finish import check_solution
+from ncd.studies import scenes
+from ncd.studies.bench import dense_packing
 
 H = 1e-3
 

@@ -337,7 +337,7 @@ def test_inconsistent_scene_and_problem_never_reach_a_kernel():
     (dict(progress=3), r"progress = 3 must be callable"),
 ])
 def test_explore_rejects(kw, pattern):
-    from ncd.explore import explore
+    from ncd.dynamics.explore import explore
     s = scene()
     p = ncd.prepare_step(s, 1e-3)
     args = dict(members=[0, 1], root_seed=7)

@@ -9,7 +9,6 @@ import textwrap
 
 import numpy as np
 import pytest
-import scipy.sparse as sp
 import xarray as xr
 
 import ncd
@@ -47,9 +46,9 @@ def test_solve_local_refuses_a_corrupt_sparse_w(make):
 def test_force_polytope_refuses_a_corrupt_sparse_h():
     code, out = run_isolated("""
         import numpy as np, scipy.sparse as sp, ncd
-        from ncd.exact_set import ExactSet
+        from ncd.exact.exact_set import ExactSet
         H = sp.csr_matrix(np.ones((3, 4))); H.indices[2] = 99
-        for make in (lambda: ncd.polytope.ForcePolytope(H, [1, 1, 1], 0.5), lambda: ExactSet(H, [1, 1, 1], 0.5)):
+        for make in (lambda: ncd.exact.polytope.ForcePolytope(H, [1, 1, 1], 0.5), lambda: ExactSet(H, [1, 1, 1], 0.5)):
             try:
                 make(); print("ACCEPTED")
             except ncd.InputError as e:
@@ -59,7 +58,7 @@ def test_force_polytope_refuses_a_corrupt_sparse_h():
 
 
 def test_exact_set_checks_its_arguments():
-    from ncd.exact_set import ExactSet
+    from ncd.exact.exact_set import ExactSet
     H = np.array([[1.0, 0.0, 1.0, 0.0], [0.0, 1.0, 0.0, 1.0]])
     with pytest.raises(ncd.InputError, match=r"mu must be finite"):
         ExactSet(H, [-1.0, 0.0], np.nan)
@@ -79,7 +78,7 @@ def test_exact_set_checks_its_arguments():
 
 
 def test_md_run_checks_the_scene_on_every_call():
-    from ncd.md import MD, MDParams
+    from ncd.dynamics.md import MD, MDParams
     s = ncd.make_scene([[0, .1], [.2, .1], [.1, .27320508]], radius=.1, walls=[((0, 0), (0, 1))])
     md = MD(s, MDParams(k_n=1e5))
     assert md.run(1e-5, 10).steps == 10
@@ -104,7 +103,7 @@ def test_sweep_budgets_beyond_the_kernels_counters_are_refused(value):
 
 
 def test_lemke_checks_covering_budget_and_scale():
-    from ncd.lcp import frictional_lcp, lemke
+    from ncd.solver.lcp import frictional_lcp, lemke
     for kw, pattern in ((dict(covering=[np.inf, 1]), r"covering must be finite"),
                         (dict(covering=[1e-320, 1]), r"covering must be 2 positive numbers >= 1e-150"),
                         (dict(max_pivots=2.7), r"max_pivots = 2\.7 must be an integer"),
@@ -128,7 +127,7 @@ def test_config_section_that_is_not_a_mapping(section):
 
     import yaml
 
-    from ncd.configcheck import ConfigError, check_config
+    from ncd.pipeline.config import ConfigError, check_config
     root = Path(__file__).resolve().parents[1]
     cfg = copy.deepcopy(yaml.safe_load((root / "config.yaml").read_text()))
     cfg["fig1_wedged"] = section
@@ -139,7 +138,7 @@ def test_config_section_that_is_not_a_mapping(section):
 def test_config_checker_refuses_what_it_cannot_read(tmp_path):
     from pathlib import Path
 
-    from ncd.configcheck import ConfigError, check_config
+    from ncd.pipeline.config import ConfigError, check_config
     root = Path(__file__).resolve().parents[1]
     with pytest.raises(ConfigError, match=r"must be a mapping of sections; got NoneType"):
         check_config(None, [], root / "workflow" / "schemas")
@@ -171,7 +170,7 @@ def test_a_period_shrunk_below_three_diameters_is_named():
 
 
 def test_outside_distance_with_a_repeated_vertex():
-    from ncd.polygon import outside_distance
+    from ncd.exact.polygon import outside_distance
     square = [[0, 0], [1, 0], [1, 0], [1, 1], [0, 1]]
     assert outside_distance([[5, 5]], square)[0] == pytest.approx(np.hypot(4, 4))
     assert outside_distance([[0.5, 0.5]], square)[0] == 0.0
@@ -180,7 +179,7 @@ def test_outside_distance_with_a_repeated_vertex():
 
 
 def test_merge_refuses_repeated_members(tmp_path):
-    from ncd.io import merge_shards
+    from ncd.io.netcdf import merge_shards
     ds = xr.Dataset({"x": ("run", np.arange(3.0))}, coords={"run": np.arange(3)})
     ds.to_netcdf(tmp_path / "a.nc")
     with pytest.raises(ValueError, match=r"repeat run \[0, 1, 2\]"):
@@ -188,7 +187,7 @@ def test_merge_refuses_repeated_members(tmp_path):
 
 
 def test_a_failed_vtk_export_leaves_the_old_one_intact(tmp_path, monkeypatch):
-    from ncd import export
+    from ncd.io import export
     frames = 3
     ds = xr.Dataset({"frame_time": ("frame", np.arange(frames) * 0.1),
                      "frame_x": (("frame", "disc"), np.zeros((frames, 2))),

@@ -2,7 +2,6 @@
 
 Unit checks of ncd.studies.bench on small packings, and checks of the data of the
 reduced DAG run (``snakemake -j2 bench`` in tests/conftest.py)."""
-import os
 import shutil
 from pathlib import Path
 
@@ -11,7 +10,7 @@ import pytest
 import xarray as xr
 
 import ncd
-from ncd.explore import explore, run_parallel
+from ncd.dynamics.explore import explore, run_parallel
 from ncd.studies import bench
 
 

@@ -1,8 +1,8 @@
-"""numba's cache follows every source of ncd (ncd/_cache.py).
+"""numba's cache follows every source of the kernel layers (ncd/core/jit.py).
 
 numba keys a cached kernel on its own file: without the digest-named cache
-directory, an edit of ``local_solver.py`` would leave the NLGS sweep of
-``nlgs.py`` (which inlines it) running the old machine code."""
+directory, an edit of ``single_contact.py`` would leave the NLGS sweep of
+``kernels.py`` (which inlines it) running the old machine code."""
 import os
 import shutil
 import subprocess
@@ -13,7 +13,7 @@ ROOT = Path(__file__).resolve().parent.parent
 
 PROBE = """
 import numpy as np, ncd
-from ncd._cache import cache_dir
+from ncd.core.jit import cache_dir
 W = np.diag([2.0, 3.0])
 print(cache_dir())
 print(ncd.solve_local(W, [-1.0, 0.5], 1.0).impulse.ravel().tolist())   # sticks
@@ -32,14 +32,24 @@ def test_an_edit_of_a_callee_module_reaches_the_cached_kernels(tmp_path):
     shutil.copytree(ROOT / "ncd", tmp_path / "ncd", ignore=shutil.ignore_patterns("__pycache__"))
     first_dir, first = probe(tmp_path)
     assert Path(first_dir).is_relative_to(tmp_path / "ncd" / "__pycache__")
-    assert any(Path(first_dir).rglob("nlgs._iterate_local*.nbi"))        # the kernels were cached
+    assert any(Path(first_dir).rglob("kernels.iterate_local*.nbi"))        # the kernels were cached
     assert probe(tmp_path) == (first_dir, first)                         # and are reused
-    # change the single-contact law inside local_solver.py only: the cached NLGS kernel
-    # of nlgs.py must see it (here: every normal impulse doubled)
-    solver = tmp_path / "ncd" / "local_solver.py"
+    # change the single-contact law inside single_contact.py only: the cached NLGS kernel
+    # of kernels.py must see it (here: every normal impulse doubled)
+    solver = tmp_path / "ncd" / "solver" / "single_contact.py"
     text = solver.read_text()
     assert text.count("return rn, rt, STICK") == 1
     solver.write_text(text.replace("return rn, rt, STICK", "return 2.0 * rn, rt, STICK"))
     second_dir, second = probe(tmp_path)
     assert second_dir != first_dir
     assert eval(second)[0] == 2.0 * eval(first)[0] != 0.0
+
+
+def test_an_edit_of_a_page_module_keeps_the_kernel_cache(tmp_path):
+    """The digest covers the kernel layers only: editing a page (or figure) module must
+    not recompile every kernel."""
+    shutil.copytree(ROOT / "ncd", tmp_path / "ncd", ignore=shutil.ignore_patterns("__pycache__"))
+    first_dir, first = probe(tmp_path)
+    page = tmp_path / "ncd" / "pages" / "report.py"
+    page.write_text(page.read_text() + "\n# an edit\n")
+    assert probe(tmp_path) == (first_dir, first)

@@ -13,7 +13,6 @@ import subprocess
 
 import pytest
 import xarray as xr
-
 from conftest import ROOT, copy_workflow, run_snakemake
 
 pytestmark = pytest.mark.cluster

@@ -5,10 +5,10 @@ import math
 
 import pytest
 import yaml
-
 from conftest import ROOT, copy_workflow, run_snakemake
+
 from ncd import InputError
-from ncd.configcheck import ConfigError, check_config
+from ncd.pipeline.config import ConfigError, check_config
 
 SCHEMAS = ROOT / "workflow" / "schemas"
 CONFIG = yaml.safe_load((ROOT / "config.yaml").read_text())

@@ -14,11 +14,12 @@ import pytest
 import yaml
 
 import ncd
-from ncd import stepper
-from ncd.figures import history, sources
-from ncd.figures.construction import build
-from ncd.model import SimulationError
-from ncd.pipeline import settings as solver_settings
+from ncd.core.errors import SimulationError
+from ncd.dynamics import stepper
+from ncd.figures import history
+from ncd.pipeline.workflow import settings as solver_settings
+from ncd.scenes import construction, sources
+from ncd.scenes.construction import build
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -39,19 +40,19 @@ def pouring():
     src = history.PointSource(cfg, history.member_rng(0, cfg["root_seed"], "point"), float(np.mean(ground[1])),
                               history.grain_radii(cfg, 0))
     box = {}
-    real = ncd.step
+    real = construction.step
 
     def keep(scene, *a, **k):
         box["scene"] = scene
         return real(scene, *a, **k)
 
-    ncd.step = keep
+    construction.step = keep
     try:
         with pytest.raises(SimulationError, match="not at rest"):
             build(cfg, ground, src, lambda p, r, v, w, a: history.pile_scene(cfg, p, r, *ground, vel=v, spin=w,
                                                                              angle=a))
     finally:
-        ncd.step = real
+        construction.step = real
     return cfg, box["scene"]
 
 

@@ -3,8 +3,8 @@ import numpy as np
 import pytest
 
 import ncd
-from ncd import convergence
-from ncd.finish import relative_residual
+from ncd.solver import convergence
+from ncd.solver.finish import relative_residual
 from ncd.studies import scenes
 
 H = 1e-3
@@ -51,7 +51,7 @@ def test_best_iterate_disc_velocities_consistent():
             for kb in (True, False)}
     res_best, vel, spin = runs[True]
     assert res_best.residual <= runs[False][0].residual
-    from ncd.finish import global_delassus
+    from ncd.solver.finish import global_delassus
     _, Hm, minv = global_delassus(scene, problem.contacts)
     du = minv * (Hm @ res_best.impulse.ravel())
     nm = scene.n_mobile

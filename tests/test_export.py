@@ -1,4 +1,4 @@
-"""ncd.export: stored frames to VTK (ParaView) and to an animation, values preserved."""
+"""ncd.io.export: stored frames to VTK (ParaView) and to an animation, values preserved."""
 import xml.etree.ElementTree as ET
 
 import meshio
@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from ncd.export import ExportError, animate, write_vtk
-from ncd.figures.frames import frames_dataset
+from ncd.io.export import ExportError, animate, write_vtk
+from ncd.scenes.frames import frames_dataset
 
 
 def _frames(n_frames=3, n_discs=4):
@@ -79,9 +79,9 @@ def test_no_frames_is_a_clear_error(tmp_path):
 
 
 def _construction(n_frames=3, n_discs=5):
-    """A construction file of Figure 4 with frames (ncd.figures.construction.add_frames):
+    """A construction file of Figure 4 with frames (ncd.scenes.construction.add_frames):
     grains poured one frame after another (NaN until poured), ground discs."""
-    from ncd.figures.construction import FRAME, add_frames
+    from ncd.scenes.construction import FRAME, add_frames
 
     rng = np.random.default_rng(2)
     fr = np.full((n_frames, len(FRAME), n_discs), np.nan)

@@ -9,9 +9,9 @@ import yaml
 from scipy.optimize import linprog
 
 import ncd
-from ncd.contacts import h_matrix
+from ncd.core.contacts import h_matrix
 from ncd.figures.wedged import Wedge, explore_shard
-from ncd.io import merge_shards, write_dataset
+from ncd.io.netcdf import merge_shards, write_dataset
 
 ROOT = Path(__file__).resolve().parent.parent
 DEFAULT = yaml.safe_load((ROOT / "config.yaml").read_text())["fig1_wedged"]
@@ -28,7 +28,7 @@ def force_vectors(w, fn, ft):
 
 def lp_normal_force(w, sense):
     """min (sense=1) or max (sense=-1) of N_0 over {H rho + F = 0, |rho_t| <= mu rho_n},
-    with H from ncd.contacts.h_matrix of the actual scene (independent of the closed form)."""
+    with H from ncd.core.contacts.h_matrix of the actual scene (independent of the closed form)."""
     scene = w.scene()
     contacts = ncd.prepare_step(scene, 1e-3, 1.0).contacts
     assert contacts.n == 2

@@ -12,8 +12,9 @@ import xarray as xr
 import yaml
 
 import ncd
-from ncd.figures import slope
-from ncd.figures import slope_analysis as sa
+from ncd.figures import census
+from ncd.scenes import slope
+from ncd.scenes import slope_analysis as sa
 
 
 # ------------------------------------------------------------------ measures
@@ -195,7 +196,7 @@ def test_the_notebook_states_the_verdict_and_the_cloud_shape(data, results):
     md = "".join("".join(o.get("data", {}).get("text/markdown", "")) for c in nb["cells"] if c["cell_type"] == "code"
                  for o in c.get("outputs", []))
     cen = xr.load_dataset(results / "fig2_slope" / "census.nc")
-    cloud = cs.cloud_against_census(ens, cen, grain, "zero")
+    cloud = sa.cloud_against_census(ens, cen, grain, "zero")
     assert cs.cloud_text(cloud, grain, float(ens.tol.min()), an["line_ratio"]) in md
     assert "two isolated solutions" not in md and "line is made of two points" not in md
 
@@ -215,12 +216,11 @@ def test_the_cloud_is_the_census_solutions_plus_the_iteration_error(data, result
     the runs' RMS distance to them (singular values are 1-Lipschitz).  One solution visited:
     the cloud is iteration error (its spread below that distance, no 'indeterminacy' verdict);
     several: the solutions' separation exceeds the iteration error."""
-    from ncd.figures import census as cs
     _, ens, meas, _, an = data
     cen = xr.load_dataset(results / "fig2_slope" / "census.nc")
     ccfg = yaml.safe_load(cen.attrs["config_yaml"])
     grain, g = int(meas.attrs["grain"]), float(meas.attrs["g"])
-    c = cs.cloud_against_census(ens, cen, grain, "zero")
+    c = sa.cloud_against_census(ens, cen, grain, "zero")
     e = ens.sel(init="zero", tol=ens.tol.min(), disc=grain)
     ok = e.converged.values.astype(bool)
     assert c["n_converged"] == ok.sum() >= 1
@@ -244,7 +244,6 @@ def test_the_cloud_is_the_census_solutions_plus_the_iteration_error(data, result
 
 def test_cloud_against_census_on_a_synthetic_segment():
     """Runs on two of three solutions plus a small error: labels, counts and the axis bound."""
-    from ncd.figures import census as cs
     rng = np.random.default_rng(7)
     sol = rng.normal(size=(3, 5, 2))                      # 3 solutions, 5 discs
     pick = np.array([0] * 7 + [2] * 13)
@@ -257,12 +256,12 @@ def test_cloud_against_census_on_a_synthetic_segment():
                      coords={"init": ["zero"], "tol": [1e-4, 1e-8]})
     cen = xr.Dataset({"accel_x": (("solution", "disc"), sol[..., 0]), "accel_y": (("solution", "disc"), sol[..., 1])},
                      attrs={"g": 9.81, "config_yaml": yaml.safe_dump({"basin_tol": 1e-3})})
-    c = cs.cloud_against_census(ens, cen, 3, "zero")
+    c = sa.cloud_against_census(ens, cen, 3, "zero")
     assert c["visited"].tolist() == [0, 2] and c["counts"].tolist() == [7, 13] and c["n_solutions"] == 3
     assert c["census_minor"] <= 1e-12 * c["census_major"]          # two points: a segment
     assert c["rms_offset"] == pytest.approx(np.sqrt(np.mean(np.sum(err[:, 3] ** 2, -1))), rel=1e-9)
     assert abs(c["major"] - c["census_major"]) <= c["rms_offset"] and c["minor"] <= c["rms_offset"]
-    assert "2 of the census's 3 exact solutions, a segment" in cs.cloud_text(c, 3, 1e-8, 0.05)
+    assert "2 of the census's 3 exact solutions, a segment" in census.cloud_text(c, 3, 1e-8, 0.05)
 
 
 def test_status_patterns_combine_the_changes_cluster_by_cluster():
@@ -307,7 +306,7 @@ def test_the_restart_reproduces_the_trajectory_step(data):
     traj, _, _, cfg, _ = data
     scene = slope.scene_at_step(traj, cfg)
     problem = ncd.prepare_step(scene, float(traj.attrs["h"]))
-    guess = ncd.stepper.initial_guess(scene, problem, "warm")
+    guess = ncd.dynamics.stepper.initial_guess(scene, problem, "warm")
     assert np.count_nonzero(guess[:, 0]) > 0.5 * problem.contacts.n
     settings = ncd.SolverSettings(**cfg["flow"]["solver"])
     result, vel, _ = ncd.solve_problem(scene, problem, guess, None, settings)
@@ -328,9 +327,9 @@ def test_census_solutions_are_exact_and_contain_the_nlgs_end_points(data, result
     """Every census solution is polished to a residual <= 1e-12 and satisfies the contact law
     componentwise; every converged NLGS run of the ensemble ends on one of them; the census
     recomputes its solutions' accelerations from its impulses."""
-    from ncd.figures import census as cs
-    from ncd.figures.slope import scene_at_step
-    from ncd.stepper import prepare_step
+    from ncd.dynamics.stepper import prepare_step
+    from ncd.scenes.slope import scene_at_step
+    from ncd.scenes.step_solutions import StepSolutions
     traj, ens, meas, cfg, an = data
     cen = xr.load_dataset(results / "fig2_slope" / "census.nc")
     ccfg = yaml.safe_load(cen.attrs["config_yaml"])
@@ -340,7 +339,7 @@ def test_census_solutions_are_exact_and_contain_the_nlgs_end_points(data, result
     ok = tight.converged.values.astype(bool)
     assert sum(int(cen[f"n_{i}"].sum()) for i in ens.init.values) == ok.sum()
     assert cen.by_nlgs.sum() >= meas.sizes["solution"]
-    step = cs.StepSolutions(scene_at_step(traj, {"scene": cfg["scene"], "flow": cfg["flow"]}),
+    step = StepSolutions(scene_at_step(traj, {"scene": cfg["scene"], "flow": cfg["flow"]}),
                             prepare_step(scene_at_step(traj, {"scene": cfg["scene"], "flow": cfg["flow"]}),
                                          float(traj.attrs["h"])))
     for k in range(cen.sizes["solution"]):

@@ -1,6 +1,6 @@
 """Figure 3 (section 4): the polytope A ∩ C, exactly and by NLGS.
 
-Unit tests of :mod:`ncd.polytope` on problems with a known answer, then the
+Unit tests of :mod:`ncd.exact.polytope` on problems with a known answer, then the
 claims of the figure on the data of the DAG run (fixture ``results``).
 """
 import numpy as np
@@ -10,11 +10,12 @@ import xarray as xr
 import yaml
 
 import ncd
-from ncd.contacts import h_matrix
-from ncd.explore import member_rng
+from ncd.core.contacts import h_matrix
+from ncd.dynamics.explore import member_rng
+from ncd.exact.polygon import boundary_distance, convex_hull, outside_distance, polygon_area
+from ncd.exact.polytope import ForcePolytope, PolytopeError
 from ncd.figures import equilibrium as fe
-from ncd.polytope import (ForcePolytope, PolytopeError, boundary_distance, convex_hull, outside_distance,
-                          polygon_area)
+from ncd.scenes.packing import external_force, rest_problem
 
 
 # ---------------------------------------------------------------- unit tests
@@ -63,9 +64,9 @@ def _wedge(beta_deg, mu):
     b = np.radians(beta_deg)
     d = (R + Ro) * np.array([np.cos(b), np.sin(b)])
     scene = ncd.make_scene([[0.0, 0.0]], R, 1.0, obstacle_pos=[-d, [d[0], -d[1]]], obstacle_radius=Ro, mu=mu)
-    problem = fe.rest_problem(scene, 1e-3)
+    problem = rest_problem(scene, 1e-3)
     assert problem.contacts.n == 2
-    F = fe.external_force(scene)
+    F = external_force(scene)
     return ForcePolytope(h_matrix(scene, problem.contacts), F, problem.contacts.mu), -F[1], b
 
 
@@ -172,7 +173,7 @@ def test_converged_runs_are_equilibria_inside_the_exact_polygons(fig3):
 
 
 def test_runs_are_classified(fig3):
-    """outcome (ncd.convergence): rest = converged and every grain slower than the stated
+    """outcome (ncd.solver.convergence): rest = converged and every grain slower than the stated
     bound; the clouds use the rest-state runs only."""
     ens = fig3["ensemble"]
     tol = fig3["cfg"]["packing"]["velocity_tol"]

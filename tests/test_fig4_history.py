@@ -13,9 +13,9 @@ import pytest
 import xarray as xr
 import yaml
 
-import ncd
-from ncd.figures import construction, history
+from ncd.figures import history
 from ncd.figures import history_analysis as ha
+from ncd.scenes import construction
 
 ROOT = Path(__file__).resolve().parent.parent
 WEIGHT_TOL = 1e-9            # every pile: vertical ground reaction vs weight (relative)
@@ -58,7 +58,7 @@ def test_restart_after_a_kill_is_bit_identical(uninterrupted, tmp_path, monkeypa
     assert n_steps > 150
     ckpt = tmp_path / "point_3.npz"
     calls = {"n": 0, "kill_at": 130}
-    real_step = ncd.step
+    real_step = construction.step
 
     def dying_step(*args, **kw):          # the first run is killed during its step 130
         calls["n"] += 1
@@ -66,7 +66,7 @@ def test_restart_after_a_kill_is_bit_identical(uninterrupted, tmp_path, monkeypa
             raise Killed("killed")
         return real_step(*args, **kw)
 
-    monkeypatch.setattr(ncd, "step", dying_step)
+    monkeypatch.setattr(construction, "step", dying_step)   # the construction loop's step
     with pytest.raises(Killed):
         history.construct(cfg, "point", 3, checkpoint=ckpt)
     saved = np.load(ckpt)
@@ -104,7 +104,8 @@ def test_pile_at_rest_and_weight(uninterrupted):
 def test_pile_file_exports_its_frames(uninterrupted, tmp_path):
     """fig4_history_point/rain of `snakemake export`: a pile file's frames to VTK."""
     import meshio
-    from ncd.export import write_vtk
+
+    from ncd.io.export import write_vtk
     cfg, (scene, rec, ground, eq, frames) = uninterrupted
     ds = history.pile_dataset(cfg, "point", 3, scene, rec, ground, eq, frames)
     discs, ground_file = write_vtk(ds, tmp_path, "point")
@@ -132,7 +133,7 @@ def test_rain_source_and_same_grains():
 
 def test_removing_grains_keeps_the_warm_start_of_the_others(uninterrupted):
     cfg, (scene, rec, ground, eq, frames) = uninterrupted
-    from ncd.contacts import detect_contacts, match_warm
+    from ncd.core.contacts import detect_contacts, match_warm
     factory = lambda p, r, v, w, a: history.pile_scene(cfg, p, r, *ground, vel=v, spin=w, angle=a)  # noqa: E731
     nm = scene.n_mobile
     old = detect_contacts(scene, alert=1e-9 * scene.radius.min())
@@ -188,7 +189,7 @@ def test_profile_and_dip_by_hand():
 
 
 def test_a_cut_crossing_no_contact_has_no_direction():
-    from ncd.figures import cuts
+    from ncd.scenes import cuts
     # arctan2(-0.0, -0.0) is -180 degrees: an empty left cut read as a 163-degree "deviation"
     phi, dev = cuts.flank_angles(np.array([-0.0, 0.0, -2.0]), np.array([0.0, -0.0, -1.0]),
                                  np.array([-1, 1, -1]), 16.5)

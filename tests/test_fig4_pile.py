@@ -9,10 +9,11 @@ import xarray as xr
 import yaml
 
 import ncd
-from ncd.contacts import Contacts, h_matrix, match_warm
-from ncd.figures import pile_exact
-from ncd.figures import cuts as cm
-from ncd.figures import pile
+from ncd.core.contacts import Contacts, h_matrix, match_warm
+from ncd.figures import pile, pile_exact
+from ncd.scenes import construction
+from ncd.scenes import cuts as cm
+from ncd.scenes import pile as pile_scenes
 
 # Stated bounds of the figure-data tests
 MAX_DEVIATION_DEG = 10.0     # resultant across the default cut vs the free-surface slope
@@ -124,8 +125,8 @@ def test_warm_memory_survives_pouring(little_pile):
            "construction": {"overlap_tolerance": 0.5}}
     nm = scene.n_mobile
     pos = np.vstack([scene.pos[:nm], [[5.0, 3.0]]])
-    new = pile.pile_scene(cfg, pos, np.append(scene.radius[:nm], 0.5), scene.pos[nm:], scene.radius[nm:])
-    pile.carry_warm(scene, new)
+    new = pile_scenes.pile_scene(cfg, pos, np.append(scene.radius[:nm], 0.5), scene.pos[nm:], scene.radius[nm:])
+    construction.carry_warm(scene, new)
     old = ncd.detect_contacts(scene, 1e-9)
     now = ncd.detect_contacts(new, 1e-9)
     np.testing.assert_array_equal(match_warm(now, new.prev_keys, new.prev_impulse),
@@ -143,8 +144,8 @@ def data(results):
 
 def _final(data):
     cfg = data["cfg"]
-    scene = pile.final_scene(cfg, data["construction"])
-    problem = pile.equilibrium_problem(cfg, scene, data["construction"])
+    scene = pile_scenes.final_scene(cfg, data["construction"])
+    problem = pile_scenes.equilibrium_problem(cfg, scene, data["construction"])
     return scene, problem
 
 

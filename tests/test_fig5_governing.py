@@ -11,11 +11,11 @@ import xarray as xr
 import yaml
 
 import ncd
-from ncd.contacts import h_matrix
+from ncd.core.contacts import h_matrix
 from ncd.figures import governing as fg
 from ncd.figures import governing_exact as ge
 from ncd.figures import governing_line as gl
-from ncd.figures.equilibrium import external_force, rest_problem
+from ncd.scenes.packing import external_force, rest_problem
 
 
 # ---------------------------------------------------------------- unit tests
@@ -211,8 +211,8 @@ def test_status_dimension_of_a_disc_in_a_corner():
     unknowns, 3 equations of motion, the Delassus matrix has rank 3 -> the impulses keeping
     the statuses form a line (a self-stress pushing the disc into the corner) along which
     no grain moves; with the wall open the floor's impulse is fixed."""
-    from ncd.finish import global_delassus
-    from ncd.stepper import prepare_step
+    from ncd.dynamics.stepper import prepare_step
+    from ncd.solver.finish import global_delassus
 
     scene = ncd.make_scene([[1.0, 1.0]], [1.0], walls=[((0.0, 0.0), (0.0, 1.0)), ((0.0, 0.0), (1.0, 0.0))],
                            gravity=(-1.0, -9.81), mu=0.5)

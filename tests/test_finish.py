@@ -1,15 +1,15 @@
 """Finishing stage (issue 13 item 2): NLGS, then the projection on its statuses' polyhedron (LP)."""
 import numpy as np
 import pytest
-
-import ncd
-from ncd import convergence, finish, finish_lp
-from ncd.finish import check_solution
-from ncd.local_solver import NO_CONTACT, STICK
-from ncd.scene import make_scene
-from ncd.studies import scenes
 from step_checks import contact_velocities as _velocities
 from step_checks import step_residual as _residual
+
+import ncd
+from ncd.core.scene import make_scene
+from ncd.solver import convergence, finish, finish_lp
+from ncd.solver.finish import check_solution
+from ncd.solver.single_contact import NO_CONTACT, STICK
+from ncd.studies import scenes
 
 H = 1e-3
 
@@ -95,7 +95,8 @@ def test_polish_agrees_with_nlgs_limit(column, lp_now):
     order = np.random.default_rng(5).permutation(problem.contacts.n)
     limit, _, _ = ncd.solve_problem(scene, problem, None, order, ncd.SolverSettings(tol=1e-13, max_sweeps=200000))
     assert limit.converged
-    dist = lambda s: np.linalg.norm(s - limit.impulse) / np.linalg.norm(limit.impulse)
+    def dist(s):
+        return np.linalg.norm(s - limit.impulse) / np.linalg.norm(limit.impulse)
     for tol in (1e-8, 1e-10):
         start, _, _ = ncd.solve_problem(scene, problem, None, order, ncd.SolverSettings(tol=tol))
         fin, _, _ = ncd.solve_problem(scene, problem, None, order,
@@ -176,8 +177,8 @@ def test_rest_polyhedron_is_the_equilibrium_set():
     Its polyhedron is A ∩ C times h: the projection of a non-admissible guess lands on
     equilibrium forces inside the Coulomb cones (ForcePolytope.violations ~ round-off), with
     the bodies at rest: an exact one-step solution (natural-map residual ~ round-off)."""
-    from ncd.contacts import h_matrix
-    from ncd.polytope import ForcePolytope
+    from ncd.core.contacts import h_matrix
+    from ncd.exact.polytope import ForcePolytope
     R, h3 = 1.0, np.sqrt(3.0)
     ground = np.array([[-4.0, 0.0], [-2.0, 0.0], [0.0, 0.0], [2.0, 0.0], [4.0, 0.0]])
     pos = np.array([[-1.0, h3], [1.0, h3], [0.0, 2 * h3], [-3.0, h3], [3.0, h3]])

@@ -83,8 +83,9 @@ def run_batch(entries, calls, seed, log):
     before running it (the last line names the call of a crash)."""
     import warnings
 
+    from fuzz_calls import call  # tests/ is on sys.path: this file runs as a script
+
     import ncd
-    from fuzz_calls import call      # tests/ is on sys.path: this file runs as a script
     warnings.simplefilter("ignore")
     np.seterr(all="ignore")
     tally, failures = {}, []
@@ -152,11 +153,11 @@ def fuzz_runs(numba_cache, tmp_path_factory):
 def test_harness_turns_an_out_of_range_kernel_index_into_an_error(numba_cache):
     """The harness itself: with NUMBA_BOUNDSCHECK=1 the NLGS kernel reached with
     review order [0, 1, 10**6] (bypassing the checks) raises IndexError, where the
-    unchecked build read out of bounds (segfault of issue 14)."""
-    code = ("import numpy as np\nimport ncd.nlgs as m, scipy.sparse as sp\n"
+    unchecked build read out of bounds (a segfault before the checks existed)."""
+    code = ("import numpy as np\nimport ncd.solver.kernels as m, scipy.sparse as sp\n"
             "W = sp.csr_matrix(2.0 * np.eye(6)); q = -np.ones(6); Wd = np.tile(2.0 * np.eye(2), (3, 1, 1))\n"
             "data = (W.indptr.astype(np.int64), W.indices.astype(np.int64), W.data, q, Wd, np.full(3, 0.5), np.zeros(6))\n"
-            "try:\n    m._sweep_local(data, np.array([0, 1, 10**6]), np.zeros(3, np.int8))\n"
+            "try:\n    m.sweep_local(data, np.array([0, 1, 10**6]), np.zeros(3, np.int8))\n"
             "except IndexError as err:\n    print('IndexError', err)\n")
     env = dict(os.environ, NUMBA_BOUNDSCHECK="1", NUMBA_CACHE_DIR=str(numba_cache))
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=TIMEOUT, env=env)

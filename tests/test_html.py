@@ -2,17 +2,15 @@
 folded, maths typeset offline, every figure shown.  ``slow`` tests open the pages in
 Debian's headless chromium (skipped without it) and keep screenshots under
 ``results/screenshots/``."""
-import os
 import re
 import shutil
 import subprocess
-from pathlib import Path
 
 import nbformat
 import pytest
 from bs4 import BeautifulSoup
 
-from ncd.render import LONG_TABLE, copy_mathjax, render
+from ncd.pages.render import LONG_TABLE, copy_mathjax, render
 
 CHROMIUM = next((shutil.which(c) for c in ("chromium", "chromium-browser", "google-chrome") if shutil.which(c)), None)
 needs_chromium = pytest.mark.skipif(CHROMIUM is None, reason="chromium absent (apt-get install -y chromium)")
@@ -107,7 +105,7 @@ def test_folded_table_counts_data_rows_only():
     import numpy as np
     import pandas as pd
 
-    from ncd.render import fold_long_tables
+    from ncd.pages.render import fold_long_tables
 
     n = LONG_TABLE + 5
     flat = pd.DataFrame({"a": np.arange(n), "b": np.arange(n)})

@@ -4,8 +4,8 @@ import pytest
 import xarray as xr
 
 import ncd
-from ncd.explore import explore, member_rng, shard_members
-from ncd.io import merge_shards, provenance, write_dataset
+from ncd.dynamics.explore import explore, member_rng, shard_members
+from ncd.io.netcdf import merge_shards, provenance, write_dataset
 
 
 def _small_packing():

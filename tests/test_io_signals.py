@@ -1,4 +1,4 @@
-"""A signal during ncd.io.write_dataset leaves neither a partial file nor a hung process.
+"""A signal during ncd.io.netcdf.write_dataset leaves neither a partial file nor a hung process.
 
 Policy (ncd/io.py): SIGTERM/SIGINT remove the ``.<name>.<pid>.part`` file and end the
 process with that signal; SIGKILL leaves it, and the next write of the same target
@@ -14,11 +14,11 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from ncd.io import write_dataset
+from ncd.io.netcdf import write_dataset
 
 WRITER = """
 import sys, numpy as np, xarray as xr
-from ncd.io import write_dataset
+from ncd.io.netcdf import write_dataset
 rng = np.random.default_rng(0)
 ds = xr.Dataset({"impulse_n": (("run", "contact"), rng.random((4000, 6000)))})
 print("ready", flush=True)

@@ -3,7 +3,7 @@ ensemble shards were removed after merging (``temp()``)."""
 import netCDF4
 import pytest
 
-from ncd.io import CONVENTIONS
+from ncd.io.netcdf import CONVENTIONS
 
 pytestmark = pytest.mark.pipeline
 

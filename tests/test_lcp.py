@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import ncd
-from ncd.lcp import frictional_lcp, impulse_of_lcp, lcp_residual, lemke
+from ncd.solver.lcp import frictional_lcp, impulse_of_lcp, lcp_residual, lemke
 
 
 def enumerate_lcp(M, q):

@@ -9,14 +9,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
-
-import ncd
-from ncd import anderson, local_exact
-from ncd.finish import check_solution, global_delassus, natural_map
-from ncd.figures.slope import scene_at_step
-from ncd.stepper import initial_guess
 from step_checks import contact_velocities as _velocities
 from step_checks import step_residual as _residual
+
+import ncd
+from ncd.dynamics.stepper import initial_guess
+from ncd.scenes.slope import scene_at_step
+from ncd.solver import anderson, local_exact
+from ncd.solver.finish import check_solution, global_delassus, natural_map
 
 DATA = Path(__file__).parent / "data" / "fig2_step50.nc"
 
@@ -81,7 +81,7 @@ def test_local_solves_finish_on_plain_nlgs_solution(step, plain_limit, accel, bu
 
 
 def test_region_solve_is_exact_there_and_leaves_the_rest(step):
-    """:func:`ncd.local_exact.solve_region` on a region of the stalled iterate: the
+    """:func:`ncd.solver.local_exact.solve_region` on a region of the stalled iterate: the
     natural map vanishes on the region's contacts (to 1e-12 of the impulses), the other
     impulses are untouched."""
     scene, problem, warm, order = step

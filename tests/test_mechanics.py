@@ -2,7 +2,7 @@
 
 Every test derives its expected numbers in its docstring and asserts them with
 tolerances that a wrong sign, a missing factor or a wrong contact law would
-break.  Conventions (``ncd.contacts``): the normal ``n`` of a contact points
+break.  Conventions (``ncd.core.contacts``): the normal ``n`` of a contact points
 from body b to the mobile disc a, ``t = (-n_y, n_x)``,
 ``U_n = (v_a - v_b).n``, ``U_t = (v_a - v_b).t - r_a w_a - r_b w_b``, and the
 impulse ``(s_n, s_t)`` acts on a as ``s_n n + s_t t`` with torque
@@ -12,10 +12,9 @@ import numpy as np
 import pytest
 
 import ncd
-from ncd.contacts import detect_contacts, h_matrix, local_velocity
-from ncd.detection import disc_pairs
-from ncd.local_solver import (NO_CONTACT, SLIDE_BACKWARD, SLIDE_FORWARD, STICK,
-                              solve_single_contact)
+from ncd.core.contacts import detect_contacts, h_matrix, local_velocity
+from ncd.core.detection import disc_pairs
+from ncd.solver.single_contact import NO_CONTACT, SLIDE_BACKWARD, SLIDE_FORWARD, STICK, solve_single_contact
 
 G = 9.81
 FLOOR = [((0.0, 0.0), (0.0, 1.0))]
@@ -549,7 +548,7 @@ def test_a_separating_contact_with_zero_impulse_has_zero_natural_map(mu):
     """r = 0 with U_n > 0, U_t = 0 solves the contact law: the natural map vanishes.
     (With mu = 0 the projection once returned (z_n < 0, 0) itself, so a frictionless
     separating contact read as unsolved and NLGS ran to max_sweeps.)"""
-    from ncd.local_solver import natural_map_sq
+    from ncd.solver.single_contact import natural_map_sq
     assert ncd.project_cone(-1.0, 0.0, mu) == (0.0, 0.0)
     assert ncd.project_cone(2.0, 0.0, mu) == (2.0, 0.0)
     assert natural_map_sq(0.0, 0.0, 1e-8, 0.0, mu, 0.5) == 0.0

@@ -27,7 +27,7 @@ def test_pair_in_sync(py):
 
 def test_unsynced_pair_is_noticed(tmp_path):
     """A .py edited without `jupytext --sync` stops the notebook with the command to run."""
-    from ncd.notebook import NotebookError, check_pair
+    from ncd.pages.notebook import NotebookError, check_pair
 
     src = NOTEBOOKS[0]
     for f in ("Snakefile", "config.yaml"):
@@ -45,7 +45,7 @@ def test_unsynced_pair_is_noticed(tmp_path):
 def test_paths_by_hand_from_root_and_from_notebooks(monkeypatch):
     """By hand, a notebook finds the repository from the root or from notebooks/ and
     writes only under results/."""
-    from ncd.notebook import paths
+    from ncd.pages.notebook import paths
 
     root = NOTEBOOKS[0].parent.parent
     for cwd in (root, root / "notebooks"):

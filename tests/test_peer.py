@@ -7,7 +7,7 @@ calibrated on root seeds 0-7 (measured values in the comments).
 import numpy as np
 import pytest
 
-from ncd.model import InputError
+from ncd.core.errors import InputError
 from ncd.studies.peer import DEFAULTS, SLOP_D, compare
 
 pytest.importorskip("pymunk")

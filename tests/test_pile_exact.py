@@ -3,10 +3,11 @@ import numpy as np
 import pytest
 
 import ncd
-from ncd.contacts import h_matrix
-from ncd.figures import pressure as pm
-from ncd.figures.pile_exact import ExactSet, resultant_angle
-from ncd.polytope import ForcePolytope
+from ncd.core.contacts import h_matrix
+from ncd.exact.exact_set import ExactSet
+from ncd.exact.polytope import ForcePolytope
+from ncd.figures.pile_exact import resultant_angle
+from ncd.scenes import pressure as pm
 
 
 def balanced(scene):

@@ -7,13 +7,10 @@ import signal
 import subprocess
 import sys
 import time
-from pathlib import Path
 
-import numpy as np
 import pytest
 import xarray as xr
 import yaml
-
 from conftest import ROOT, copy_workflow, run_snakemake
 
 SCHEMAS = ROOT / "workflow" / "schemas"
@@ -268,7 +265,7 @@ def test_an_ensemble_is_identical_with_its_attributes_whatever_the_shard_count(d
 def test_a_failing_job_writes_its_traceback_to_its_log(tmp_path):
     """An uncaught exception of a script reaches its ``log:`` file, not only the console."""
     (tmp_path / "fail.py").write_text(
-        "from ncd.pipeline import start\n"
+        "from ncd.pipeline.workflow import start\n"
         "log = start(snakemake)\n"
         "log.info('about to fail')\n"
         "def deep(x):\n    raise ValueError(f'no such member: {x}')\n"
@@ -286,7 +283,7 @@ def test_a_failing_job_writes_its_traceback_to_its_log(tmp_path):
 
 def test_sigterm_of_a_job_is_logged_and_runs_its_cleanup(tmp_path):
     """A job terminated by SIGTERM (Snakemake cancelling it) exits 143 through ``finally``."""
-    code = ("import time, types\nfrom ncd.pipeline import start\n"
+    code = ("import time, types\nfrom ncd.pipeline.workflow import start\n"
             f"log = start(types.SimpleNamespace(threads=1, rule='demo', log=[{str(tmp_path / 'j.log')!r}]))\n"
             "try:\n    print('ready', flush=True)\n    time.sleep(60)\n"
             f"finally:\n    open({str(tmp_path / 'cleaned')!r}, 'w').close()\n")
@@ -320,7 +317,7 @@ def test_an_interrupted_run_reruns_without_flags_and_gives_the_same_file(dag_rep
     """Kill Snakemake in the middle of an ensemble job (fig1's first shard), then a plain rerun:
     no --unlock, no --rerun-incomplete; no half-written output at any time; the
     interrupted job is redone and the merged file equals the uninterrupted run's."""
-    from ncd.pipeline import _snakemake_processes
+    from ncd.pipeline.workflow import _snakemake_processes
 
     work = tmp_path / "work"
     target = "results/fig1_wedged/ensemble.nc"

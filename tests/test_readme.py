@@ -1,25 +1,43 @@
-"""The README: its solver example runs, it keeps no hand-typed result numbers (it points
-to results/index.html, built from the data), its pictures exist, config/README.md is
-up to date, and it uses no words of the project's process."""
+"""The README is a user guide: its solver example runs, it keeps no hand-typed measured
+numbers (it points to results/index.html and the bench page, built from the data), it
+stays short, its pictures exist, config/README.md is up to date, docs/solvers.md has a
+section per solver method, and neither uses words of the project's process."""
 import re
 import subprocess
 import sys
 from pathlib import Path
 
-from ncd.configdoc import TARGET, render
-
 ROOT = Path(__file__).resolve().parent.parent
 README = (ROOT / "README.md").read_text()
+SOLVERS = ROOT / "docs" / "solvers.md"
+MAX_LINES = 220
 
 
-def section(title):
-    start = README.index(f"## {title}")
-    end = README.find("\n## ", start + 3)
-    return README[start:end if end > 0 else None]
+def section(title, text=README):
+    start = text.index(f"## {title}")
+    end = text.find("\n## ", start + 3)
+    return text[start:end if end > 0 else None]
+
+
+def prose(text):
+    """``text`` without fenced code blocks, inline code and HTML tags."""
+    text = re.sub(r"```.*?```", "", text, flags=re.DOTALL)
+    text = re.sub(r"`[^`\n]*`", "", text)
+    return re.sub(r"<[^>]*>", "", text)
+
+
+# A number followed by a unit of time, a speed-up factor, a percentage or a count of
+# what a run measures: hand-typed results, which belong on the generated pages.
+MEASURED = re.compile(
+    r"\d[\d.,]*\s*(?:[-–]\s*\d[\d.,]*\s*)?"
+    r"(?:(?:s|sec|secs|seconds?|min|mins|minutes?|ms|µs|us|ns|h|hours?)\b|[x×](?![\w])|%"
+    r"|\s*(?:sweeps?|tests?|jobs?|passed|failed|skipped|runs?|orders?)\b)", re.IGNORECASE)
+COMMIT = re.compile(r"(?<![\w-])(?=[0-9a-f]*[a-f])(?=[0-9a-f]*[0-9])[0-9a-f]{7,40}(?![\w-])")
+ISSUE = re.compile(r"\bissues?\s*#?\s*\d+|#\d+\b", re.IGNORECASE)
 
 
 def test_readme_example_matches_closed_form():
-    code = re.search(r"## The solver in 15 lines\n\n```python\n(.*?)```", README, re.S).group(1)
+    code = re.search(r"## The solver in 15 lines\n\n```python\n(.*?)```", README, re.DOTALL).group(1)
     assert len(code.strip().splitlines()) <= 20
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     lines = out.strip().splitlines()
@@ -35,9 +53,56 @@ def test_results_are_not_repeated_but_pointed_to():
     """The result table keeps no measured number: only § and figure numbers remain."""
     text = section("What is reproduced")
     assert "results/index.html" in text
-    prose = re.sub(r"<img[^>]*>|`[^`]*`|§\d|Fig\. \d|\d+°|\(\d\)", "", text)
-    numbers = re.findall(r"\d[\d.,]*\s*(?:%|m/s|N\b|s\b|R\b)?", prose)
+    stripped = re.sub(r"<img[^>]*>|`[^`]*`|§\d|Fig\. \d|\d+°|\(\d\)", "", text)
+    numbers = re.findall(r"\d[\d.,]*\s*(?:%|m/s|N\b|s\b|R\b)?", stripped)
     assert numbers == [], f"hand-typed numbers in the README's result table: {numbers}"
+
+
+def test_no_hand_typed_measurements_anywhere():
+    """No timing, speed-up, percentage or count of sweeps/tests/jobs in the README's prose:
+    they are on results/index.html and results/html/bench.html, measured by the run."""
+    found = [m.group(0) for m in MEASURED.finditer(prose(README))]
+    assert not found, f"hand-typed measured numbers in README.md: {found}"
+    assert "results/html/bench.html" in README and "snakemake -j2 bench" in README
+    assert "docs/solvers.md" in README
+
+
+def test_measurement_pattern_catches_the_usual_forms():
+    for text in ("took 29 min", "in 6 min 4 s", "0.25 s", "12 ns", "a 1.97× speed-up", "3x faster",
+                 "27 %", "514 tests", "168 jobs", "150,930 sweeps", "139 passed", "2.6–6.9 s"):
+        assert MEASURED.search(text), text
+    for text in ("Python 3.11", "§3, Fig. 2", "Powders and Grains 2005", "hal-01824602", "10⁴ grains",
+                 "layer 3", "2-D"):
+        assert not MEASURED.search(text), text
+
+
+def test_readme_is_short():
+    n = len(README.splitlines())
+    assert n <= MAX_LINES, f"README.md has {n} lines (at most {MAX_LINES}): move details to docs/"
+
+
+def test_no_history_of_the_work():
+    """No commit hashes, issue numbers or sessions: the README and docs/solvers.md say what
+    is, not how it came to be."""
+    for path in (ROOT / "README.md", SOLVERS):
+        text = path.read_text()
+        assert not COMMIT.findall(text), f"{path.name}: commit hashes {COMMIT.findall(text)}"
+        assert not ISSUE.findall(text), f"{path.name}: issue numbers {ISSUE.findall(text)}"
+        assert "session" not in text.lower(), f"{path.name} mentions a session"
+    assert COMMIT.search("a fresh clone of cbf73d9") and not COMMIT.search("(hal-01824602)")
+
+
+def test_solvers_doc_has_a_section_per_method():
+    text = SOLVERS.read_text()
+    headings = [h.lower() for h in re.findall(r"^## (.+)$", text, re.MULTILINE)]
+    for method, words in {"plain NLGS": ("nlgs",), "Anderson": ("anderson",), "local exact": ("local exact",),
+                          "finishing stage": ("finishing",), "Lemke": ("lemke",),
+                          "failed experiments": ("did not work",),
+                          "hand-written code": ("hand-written",)}.items():
+        assert any(all(w in h for w in words) for h in headings), f"docs/solvers.md lacks a section on {method}"
+    for setting in ('accel="anderson"', "local_exact=True", 'finish="active_set"', "finish_tol", "keep_best",
+                    "observable_tol", "check_every", "ncd.solver.lcp", "snakemake -j2 bench"):
+        assert setting in text, setting
 
 
 def test_readme_pictures_exist():
@@ -54,17 +119,31 @@ def test_readme_pictures_exist():
 
 def test_quick_start_has_a_virtual_environment_and_two_commands():
     text = section("Quick start")
-    assert "python -m venv .venv" in text
+    assert "python -m venv .venv && . .venv/bin/activate" in text
     assert 'python -m pip install -e ".[test]" && snakemake -j2' in text and "\npytest\n" in text
+    assert 'pytest -m "not pipeline"' in text
+    for marker in ("`slow`", "`cluster`", "`pipeline`"):
+        assert marker in text, marker
+
+
+def test_layout_names_the_layers_and_the_import_check():
+    text = section("Layout")
+    for pkg in ("core", "io", "solver", "exact", "dynamics", "pipeline", "scenes", "figures", "studies", "pages"):
+        assert f"`ncd/{pkg}`" in text, pkg
+    for path in ("workflow/", "notebooks/", "tests/", "docs/"):
+        assert path in text, path
+    assert "lint-imports" in text and "tests/test_layers.py" in text
 
 
 def test_no_process_words():
-    for words in ("the issue", "design card", "helper", "the brief"):
-        assert words not in README.lower(), words
+    for text in (README, SOLVERS.read_text()):
+        for words in ("the issue", "design card", "helper", "the brief", "an earlier session"):
+            assert words not in text.lower(), words
 
 
 def test_config_reference_is_up_to_date():
-    assert TARGET.read_text() == render(), "config/README.md is stale: run `python -m ncd.configdoc`"
+    from ncd.pages.configdoc import TARGET, render
+    assert TARGET.read_text() == render(), "config/README.md is stale: run `python -m ncd.pages.configdoc`"
 
 
 def test_license_and_citation():

@@ -3,7 +3,6 @@ input and output is relative to the working directory."""
 import shutil
 
 import pytest
-
 from conftest import run_snakemake
 
 

@@ -3,7 +3,7 @@ new figures listed, run times from the benchmark files."""
 import numpy as np
 import xarray as xr
 
-from ncd.report import CLAIMS, DIFFERS, NOT_COMPUTED, REPRODUCED, build_page, evaluate, fig1_threshold, run_times
+from ncd.pages.report import CLAIMS, DIFFERS, NOT_COMPUTED, REPRODUCED, build_page, evaluate, fig1_threshold, run_times
 
 
 def test_missing_data_gives_not_computed_and_the_page_builds(tmp_path):

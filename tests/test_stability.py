@@ -1,6 +1,6 @@
 """Issue 5: the MD baseline, the stability table and the work-precision data.
 
-Unit tests of :mod:`ncd.md` run in a second; the others read the results of a DAG
+Unit tests of :mod:`ncd.dynamics.md` run in a second; the others read the results of a DAG
 run (fixture ``results``: the reduced configuration, or ``NCD_RESULTS_DIR``).
 """
 import numpy as np
@@ -8,7 +8,7 @@ import pytest
 import xarray as xr
 
 import ncd
-from ncd.md import MD, MDParams, critical_step, restitution_from_zeta, zeta_from_restitution
+from ncd.dynamics.md import MD, MDParams, critical_step, restitution_from_zeta, zeta_from_restitution
 
 R = 0.01
 
@@ -84,7 +84,7 @@ def test_md_coulomb_slider_on_incline():
 
 def test_md_forces_balance_weight_at_rest():
     """A damped disc settles on the floor: the floor's force equals its weight."""
-    from ncd.md import external_force
+    from ncd.dynamics.md import external_force
     s = ncd.make_scene([[0.0, R]], R, 1.0, walls=[((0.0, 0.0), (0.0, 1.0))], mu=0.5)
     k_n = 1.0e3
     md = MD(s, MDParams(k_n=k_n))
@@ -102,6 +102,7 @@ def test_unconverged_steps_go_on_from_the_last_sweep():
     from pathlib import Path
 
     import yaml
+
     from ncd.studies import stability as S
 
     cfg = yaml.safe_load((Path(__file__).resolve().parent.parent / "config.yaml").read_text())["stability"]

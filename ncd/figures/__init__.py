@@ -1,4 +1,16 @@
-"""The scenes of the paper's figures: building, simulating and exploring them.
+"""Layer 7, figures: the analysis of each figure of the paper, one group of modules per
+figure, each turning a config section into xarray Datasets.
 
-One module per figure; each turns a config section into xarray Datasets.
+A figure's module imports only modules of its own figure (:data:`FIGURE_MODULES`) and
+the layers below; what two figures share lives in :mod:`ncd.scenes`.  The workflow
+reads the same table: a figure's computing rules depend on its own modules only.
 """
+FIGURE_MODULES = {
+    "fig1_wedged": ("wedged",),
+    "fig2_slope": ("census",),
+    "fig3_equilibrium": ("equilibrium", "faces"),
+    "fig4_pile": ("pile", "pile_exact"),
+    "fig4_history": ("history", "history_analysis", "history_exact", "history_plots", "history_size"),
+    "fig5_governing": ("governing", "governing_exact", "governing_flow", "governing_line", "governing_plot",
+                       "governing_summary"),
+}

@@ -3,12 +3,12 @@
 NLGS from the zero guess reaches a few end points; that does not say how many
 solutions the step has.  The census gathers exact solutions from three sources,
 each polished on its contact statuses to a relative natural-map residual
-``<= polish_tol`` (:func:`ncd.finish.project_statuses`, minimum-norm correction):
+``<= polish_tol`` (:func:`ncd.solver.finish.project_statuses`, minimum-norm correction):
 
 * ``nlgs``: the distinct end points of the figure's ensemble (zero-guess and
   warm-start runs at the tightest tolerance) and of ``random_runs`` NLGS runs
   from random guesses;
-* ``lemke``: Lemke's method (:mod:`ncd.lcp`) on the LCP form of the step (size
+* ``lemke``: Lemke's method (:mod:`ncd.solver.lcp`) on the LCP form of the step (size
   ``3 kappa``), with the covering vector ``1`` and ``lemke_runs - 1`` random ones,
   log-uniform over ``± lemke_decades`` decades (each follows its own
   complementary path);
@@ -17,7 +17,7 @@ each polished on its contact statuses to a relative natural-map residual
   statuses of one solution or, when small, any combination of the statuses seen
   at its contacts; all combinations up to ``max_patterns``, else every
   single-cluster change of every solution plus seeded random combinations
-  (:func:`ncd.figures.slope_analysis.status_patterns`).  Each pattern is solved on its statuses, polished
+  (:func:`ncd.scenes.slope_analysis.status_patterns`).  Each pattern is solved on its statuses, polished
   and kept when exact; repeated while new solutions appear
   (:func:`enumerate_statuses`, at most ``enumeration_rounds``).
 
@@ -32,65 +32,17 @@ import time
 import numpy as np
 import xarray as xr
 
-from ..explore import explore
-from ..finish import check_solution, global_delassus, natural_map, project_statuses, relative_residual
-from ..io import provenance
-from ..lcp import frictional_lcp, impulse_of_lcp, lemke
-from ..local_solver import STICK, SLIDE_BACKWARD
-from ..nlgs import SolverSettings
-from ..stepper import prepare_step, solve_problem
-from .slope_analysis import cloud_against_census, status_patterns, switching_contacts  # noqa: F401
+from ncd.dynamics.explore import explore
+from ncd.dynamics.stepper import prepare_step, solve_problem
+from ncd.io.netcdf import provenance
+from ncd.scenes.slope import scene_at_step
+from ncd.scenes.slope_analysis import status_patterns, switching_contacts
+from ncd.scenes.step_solutions import StepSolutions
+from ncd.solver.finish import check_solution, project_statuses
+from ncd.solver.lcp import frictional_lcp, impulse_of_lcp, lemke
+from ncd.solver.settings import SolverSettings
 
 METHODS = ("nlgs", "lemke", "enumeration")
-
-
-class StepSolutions:
-    """The core problem of one step in local form ``U = W s + q`` with its disc velocities."""
-
-    def __init__(self, scene, problem):
-        c = problem.contacts
-        self.scene, self.problem, self.h, self.nm = scene, problem, problem.h, scene.n_mobile
-        self.W, self.H, self.minv = global_delassus(scene, c)
-        nm = self.nm
-        self.free = np.column_stack([problem.free_vel[:nm], problem.free_spin[:nm]]).ravel()
-        self.q = (self.H.T @ self.free).reshape(-1, 2) + problem.bias
-        self.mu = c.mu
-        self.rho = 1.0 / self.W.diagonal()[0::2]
-        self.scale = float(np.sqrt(np.sum((self.q * self.rho[:, None]) ** 2)))
-        self.g = float(np.linalg.norm(scene.gravity))
-
-    def U(self, s):
-        return (self.W @ np.asarray(s).ravel()).reshape(-1, 2) + self.q
-
-    def residual(self, s):
-        return relative_residual(np.asarray(s).reshape(-1, 2), self.U(s), self.mu, self.rho, self.scale)
-
-    def status(self, s):
-        return natural_map(np.asarray(s).reshape(-1, 2), self.U(s), self.mu, self.rho)[1]
-
-    def accel(self, s):
-        """Accelerations (nm, 2) of the grains: ``(u_f - u_i) / h``."""
-        u = (self.free + self.minv * (self.H @ np.asarray(s).ravel())).reshape(-1, 3)
-        return (u[:, :2] - self.problem.vel_initial[:self.nm]) / self.h
-
-    def polish(self, s, status=None, tol=1e-12, rounds=12):
-        """Project ``s`` on the affine set of its statuses, re-read them, repeat:
-        ``(s, residual)`` of the best iterate (residual ``<= tol`` when it succeeded)."""
-        s = np.asarray(s, float).reshape(-1, 2)
-        status = self.status(s) if status is None else np.where(status > SLIDE_BACKWARD, STICK, status)
-        best = (self.residual(s), s)
-        for _ in range(rounds):
-            s = project_statuses(self.W, self.q.ravel(), self.mu, s, status.astype(np.int8))
-            res = self.residual(s)
-            if res < best[0]:
-                best = (res, s)
-            if res <= tol:
-                break
-            new = self.status(s)
-            if np.array_equal(new, status):
-                break
-            status = new
-        return best[1], best[0]
 
 
 class Census:
@@ -162,7 +114,6 @@ def nlgs_end_points(ens, measures):
 
 def run_census(traj, ens, measures, cfg, log=None):
     """The census of the investigated step: a dict of arrays and counts (see :func:`census_dataset`)."""
-    from .slope import scene_at_step
     cc = cfg["census"]
     scene = scene_at_step(traj, cfg)
     problem = prepare_step(scene, float(traj.attrs["h"]))
@@ -315,7 +266,7 @@ def census_dataset(traj, ens, measures, cfg, log=None):
 
 def cloud_text(c, grain, tol, line_ratio):
     """Markdown: what the chosen grain's cloud is, from
-    :func:`ncd.figures.slope_analysis.cloud_against_census` (re-exported here)."""
+    :func:`ncd.scenes.slope_analysis.cloud_against_census` (re-exported here)."""
     g = c["g"]
     head = (f"At {tol:.0e}, {c['n_converged']} of the {c['n_runs']} zero-guess runs converged; the cloud of "
             f"grain {grain} has RMS extents {c['major']:.2g} and {c['minor']:.2g} m/s² (minor/major "

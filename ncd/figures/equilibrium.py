@@ -8,7 +8,7 @@ that packing is then solved many times by NLGS (:func:`run_ensemble`), in the
 three exploration modes of section 2: zero guess with a random review order
 per run (the paper's figure), random initial guesses from a stated range, and
 the warm-start guess (the impulses of the last deposition step).  The exact
-projections of ``A ∩ C`` (:mod:`ncd.polytope`) and a uniform sample of it
+projections of ``A ∩ C`` (:mod:`ncd.exact.polytope`) and a uniform sample of it
 (:func:`projection_dataset`, :func:`uniform_dataset`) are the references the
 clouds are measured against (:func:`cloud_measures`).
 """
@@ -17,14 +17,16 @@ from dataclasses import replace
 import numpy as np
 import xarray as xr
 
-from ..contacts import h_matrix, match_warm
-from ..convergence import MAX_SPEED_ATTRS, REST, outcome_attrs
-from ..explore import explore, member_rng, shard_members
-from ..io import provenance
-from ..nlgs import SolverSettings
-from ..polytope import ForcePolytope, PolytopeError, boundary_distance, hull_area
-from ..scene import make_scene
-from ..stepper import equilibrium_test, prepare_step, step
+from ncd.core.contacts import h_matrix, match_warm
+from ncd.core.scene import make_scene
+from ncd.dynamics.explore import explore, member_rng, shard_members
+from ncd.dynamics.stepper import equilibrium_test, step
+from ncd.exact.polygon import boundary_distance, hull_area
+from ncd.exact.polytope import ForcePolytope, PolytopeError
+from ncd.io.netcdf import provenance
+from ncd.scenes.packing import external_force, rest_problem
+from ncd.solver.convergence import MAX_SPEED_ATTRS, REST, outcome_attrs
+from ncd.solver.settings import SolverSettings
 
 MODES = ("zero", "random", "warm")
 
@@ -87,19 +89,6 @@ def deposit(cfg, progress=None):
     raise RuntimeError(f"the packing is not at rest after {p['max_steps']} steps "
                        f"(speed {speed:.3g} |g| h, test |u_f| = {eq.max_velocity:.3g} |g| h): "
                        "raise packing.max_steps")
-
-
-def rest_problem(scene, h):
-    """The core problem of one step from ``u_i = 0`` (the equilibrium test's problem)."""
-    return prepare_step(scene, h, 1.0, vel=np.zeros_like(scene.vel), spin=np.zeros_like(scene.spin))
-
-
-def external_force(scene):
-    """Generalized external force per mobile disc ``(m g_x, m g_y, 0)``, flat (3 N,)."""
-    nm = scene.n_mobile
-    F = np.zeros((nm, 3))
-    F[:, :2] = scene.mass[:nm, None] * scene.gravity[None]
-    return F.ravel()
 
 
 def state_dataset(scene, info, cfg):
@@ -182,7 +171,7 @@ def run_ensemble(state, cfg, mode, shard, n_shards, progress=None):
     runs = mode_runs(cfg, mode)
     members = runs[shard_members(len(runs), shard, n_shards)]
     h = state.attrs["h"]
-    # every run finished by the active-set stage (ncd.finish): NLGS at tol leaves grain
+    # every run finished by the active-set stage (ncd.solver.finish): NLGS at tol leaves grain
     # speeds of ~1e-6 |g| h, the rest bound itself, so the classification rests on an
     # exact solution (residual <= finish_tol) and not on the iteration error
     settings = replace(_settings(cfg), finish="active_set")
@@ -227,7 +216,7 @@ def convergence_history(state, cfg, mode, run, sweeps):
 
 
 def polytope_of(state):
-    """:class:`ncd.polytope.ForcePolytope` of the packing: ``H r + F = 0``, Coulomb sectors."""
+    """:class:`ncd.exact.polytope.ForcePolytope` of the packing: ``H r + F = 0``, Coulomb sectors."""
     scene, problem = scene_from_state(state)
     return ForcePolytope(h_matrix(scene, problem.contacts), external_force(scene), problem.contacts.mu)
 
@@ -336,7 +325,7 @@ def cloud_measures(ensemble, projection, uniform, contacts, band=0.05):
         poly = polygon(projection, k)
         area = float(projection.area[k])
         for name, ds in groups:
-            if name != "uniform":       # converged runs at rest only (ncd.convergence)
+            if name != "uniform":       # converged runs at rest only (ncd.solver.convergence)
                 rest = ds.outcome.values == REST if "outcome" in ds else ds.converged.values == 1
                 ds = ds.isel(run=np.nonzero(rest)[0])
             pts = np.column_stack([ds.force_n.values[:, k], ds.force_t.values[:, k]])

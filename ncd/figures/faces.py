@@ -1,6 +1,6 @@
 """Where NLGS solutions lie in A ∩ C, measured over every run (Moreau 2005, section 4).
 
-For each equilibrium force vector ``r`` of a :class:`ncd.polytope.ForcePolytope`:
+For each equilibrium force vector ``r`` of a :class:`ncd.exact.polytope.ForcePolytope`:
 the dimension of the face of A ∩ C holding it (the Coulomb rows it satisfies
 with equality, within ``tol`` of the force scale), the contacts carrying no
 force (``r_n <= tol``) and the contacts sliding at the Coulomb limit

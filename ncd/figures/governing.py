@@ -27,15 +27,15 @@ Every packing draws from ``default_rng((member, root_seed))`` with
 import numpy as np
 import xarray as xr
 
-from ..contacts import h_matrix, match_warm
-from ..explore import member_rng, shard_members
-from ..io import merge_shards, provenance
-from ..model import InputError
-from ..nlgs import SolverSettings
-from ..scene import make_scene
-from ..stepper import equilibrium_test, solve_problem, step
-from .equilibrium import external_force, rest_problem
-from .governing_exact import exact_measures, unger_eta
+from ncd.core.contacts import h_matrix, match_warm
+from ncd.core.errors import InputError
+from ncd.core.scene import make_scene
+from ncd.dynamics.explore import member_rng, shard_members
+from ncd.dynamics.stepper import equilibrium_test, solve_problem, step
+from ncd.figures.governing_exact import exact_measures, unger_eta
+from ncd.io.netcdf import merge_shards, provenance
+from ncd.scenes.packing import external_force, rest_problem
+from ncd.solver.settings import SolverSettings
 
 KINDS = ("plates", "box")
 

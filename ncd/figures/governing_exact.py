@@ -1,7 +1,7 @@
 """Exact measures of ``A ∩ C`` for the packings of figure 5 (Moreau 2005, section 4).
 
-Per packing (``H r + F = 0`` from :func:`ncd.contacts.h_matrix`, Coulomb sectors,
-scaled as in :class:`ncd.polytope.ForcePolytope`):
+Per packing (``H r + F = 0`` from :func:`ncd.core.contacts.h_matrix`, Coulomb sectors,
+scaled as in :class:`ncd.exact.polytope.ForcePolytope`):
 
 * ``rank H``, ``dim A = 2 kappa - rank H``;
 * the exact range ``[min, max]`` of every contact's normal and tangential force
@@ -30,13 +30,13 @@ scaled as in :class:`ncd.polytope.ForcePolytope`):
 import highspy
 import numpy as np
 
-from ..exact_set import cone_columns, sector_model
-from ..polytope import ForcePolytope, PolytopeError
+from ncd.exact.exact_set import cone_columns, sector_model
+from ncd.exact.polytope import ForcePolytope, PolytopeError
 
 
 class _Model:
     """One HiGHS model of the scaled ``A ∩ C`` with the Coulomb sectors as column bounds
-    (:func:`ncd.exact_set.cone_columns`: ``x = T y``, ``y >= 0``), so that its only rows are
+    (:func:`ncd.exact.exact_set.cone_columns`: ``x = T y``, ``y >= 0``), so that its only rows are
     the equilibrium equations ``A_eq x = b_eq``; queries take and return ``x`` (scaled
     forces).  Only the objective changes between solves; :meth:`minimize` can restart
     from a stored basis (``start``).  Measured on a 200-disc packing at mu = 0.01 (786

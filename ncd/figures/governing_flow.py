@@ -14,7 +14,7 @@ seconds, and scanned at the same times ``scan_every, 2 scan_every, ...`` whateve
 (:func:`scan_step`): ``runs`` zero-guess and ``runs`` warm-start NLGS runs with random
 review orders (tolerance ``tol``, Figure 2's scan), converged when the natural-map
 residual is below ``tol`` and the grain accelerations have stopped changing
-(:mod:`ncd.convergence`); unconverged runs are counted and excluded.  Per scan: the
+(:mod:`ncd.solver.convergence`); unconverged runs are counted and excluded.  Per scan: the
 distinct solutions of the converged runs (both inits pooled), the largest RMS spread of a
 grain's acceleration, and at every step with two solutions or more the measures of
 :mod:`.governing_line` (why a line).
@@ -22,15 +22,16 @@ grain's acceleration, and at every step with two solutions or more the measures 
 import numpy as np
 import xarray as xr
 
-from ..explore import explore
-from ..io import provenance
-from ..model import InputError
-from ..nlgs import SolverSettings
-from ..scene import make_scene
-from ..stepper import prepare_step, step
-from . import slope
-from .governing_line import line_analysis
-from .slope_analysis import solutions
+from ncd.core.errors import InputError
+from ncd.core.scene import make_scene
+from ncd.dynamics.explore import explore
+from ncd.dynamics.stepper import prepare_step, step
+from ncd.figures.governing_line import line_analysis
+from ncd.io.netcdf import provenance
+from ncd.scenes import slope
+from ncd.scenes.slope_analysis import solutions
+from ncd.scenes.step_solutions import StepSolutions
+from ncd.solver.settings import SolverSettings
 
 FACTORS = ("base", "mu", "h", "slope")
 SCAN_VARS = {
@@ -189,7 +190,6 @@ def _exact_solutions(scene, problem, acc, imp, reps, spread, sc, g):
     """Polish each distinct end point on its statuses (:class:`.census.StepSolutions`) to a
     natural-map residual ``<= polish_tol``; the polished ones still distinct are exact
     solutions (``n_exact``); with two or more, the measures of :mod:`.governing_line`."""
-    from .census import StepSolutions
 
     st = StepSolutions(scene, problem)
     sols, status, failed = [], [], 0

@@ -2,12 +2,12 @@
 
 At a step whose converged NLGS runs reach several distinct solutions (acceleration
 fields further apart than a threshold), with the exact solutions ``s_k``
-(representatives polished on their statuses, :class:`ncd.figures.census.StepSolutions`):
+(representatives polished on their statuses, :class:`ncd.scenes.step_solutions.StepSolutions`):
 
 * :func:`switched_contacts`: the contacts whose status (open, stick, slide forward,
   slide backward) differs between the solutions;
 * :func:`status_dimension`: the dimension of the affine set of impulses keeping the
-  statuses of one solution (the most frequent), ``dim null K``, ``K = S^T W P`` (:func:`ncd.finish.status_system`:
+  statuses of one solution (the most frequent), ``dim null K``, ``K = S^T W P`` (:func:`ncd.solver.finish.status_system`:
   the velocity equations of its sticking and sliding contacts), and the dimension of
   the grain velocities it spans, ``dim null K - dim null [K; H P]`` (an upper bound of
   the local dimension of the solution set when an inequality is tight);
@@ -25,8 +25,8 @@ solutions always span one direction: the test has content from three solutions o
 """
 import numpy as np
 
-from ..finish import status_system
-from .slope_analysis import rigid_clusters
+from ncd.scenes.slope_analysis import rigid_clusters
+from ncd.solver.finish import status_system
 
 STATUS_NAMES = ("open", "stick", "slide forward", "slide backward")
 
@@ -105,7 +105,7 @@ def line_analysis(accel, status, body_a, body_b, cloud, grain, threshold, W=None
     for that grain: its cloud is predicted a line when its cluster (the connected group of
     differing grains it belongs to) has one degree of freedom, i.e. the solutions
     restricted to the cluster span one direction.  With ``W, H, mu``
-    (:func:`ncd.finish.global_delassus`) the status dimensions of the first (most frequent)
+    (:func:`ncd.solver.finish.global_delassus`) the status dimensions of the first (most frequent)
     solution are added (two dense SVDs of size ~2 kappa).  Returns a dict of numbers."""
     accel, status = np.asarray(accel, float), np.asarray(status)
     switched = switched_contacts(status)

@@ -3,8 +3,8 @@ coordination (packings); indeterminate flow steps against mu, h and slope, and w
 import matplotlib.pyplot as plt
 import numpy as np
 
-from .governing import KINDS, eta_table
-from .governing_summary import factor_table, line_counts
+from ncd.figures.governing import KINDS, eta_table
+from ncd.figures.governing_summary import factor_table, line_counts
 
 UNGER_PEAK_MU = 0.1     # Unger, Kertész & Wolf (2005): eta peaks near mu = 0.1, eta ∝ mu below
 

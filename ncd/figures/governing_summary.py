@@ -11,7 +11,7 @@
 """
 import numpy as np
 
-from .governing_flow import FACTORS
+from ncd.figures.governing_flow import FACTORS
 
 FACTOR_VAR = {"mu": "mu", "h": "h", "slope": "slope_deg"}
 

@@ -3,7 +3,7 @@
 Member ``m`` of history ``point`` or ``rain`` is built from independent
 generators ``default_rng((m, root_seed, stream))``:
 
-* stream 0: the rough ground (:func:`ncd.figures.pile.make_ground`), the same for both histories;
+* stream 0: the rough ground (:func:`ncd.scenes.pile.make_ground`), the same for both histories;
 * stream 1: the grain radii, in order of insertion, the same for both histories;
 * stream 2 (point) or 3 (rain): the source (slot order and jitter, or rain positions).
 
@@ -14,20 +14,20 @@ a sieve onto a base of finite size: Vanel et al. 1999; Geng et al. 2001), the ra
 pile stands on a finite base: the member's ground discs with ``|x| <= L`` only.
 Grains that roll off its edges are removed from the simulation once their centre
 falls ``DROP_D`` mean diameters below the ground discs' centres
-(:func:`ncd.figures.construction.build`), and the rain goes on, from the same
+(:func:`ncd.scenes.construction.build`), and the rain goes on, from the same
 sequence of radii (stream 1, continued past ``grains.n``), until ``grains.n`` grains
 stand on the base or ``rain.pour_limit * grains.n`` have been poured: the rain pile
 holds as many grains as the point pile (unless the limit stops it: ``n_grains`` and
-``n_removed`` say), its first ``grains.n`` poured grains are the point pile's.  Construction: :func:`ncd.figures.construction.build`
+``n_removed`` say), its first ``grains.n`` poured grains are the point pile's.  Construction: :func:`ncd.scenes.construction.build`
 (checkpoints, frames); the final state, its history forces and the frames go to one
 netCDF file per pile.
 """
 import numpy as np
 import xarray as xr
 
-from .construction import add_frames, build
-from .pile import construction_dataset, free_surface, make_ground, pile_scene
-from .sources import PointSource, RainSource, mean_diameter
+from ncd.scenes.construction import add_frames, build
+from ncd.scenes.pile import construction_dataset, free_surface, make_ground, pile_scene
+from ncd.scenes.sources import PointSource, RainSource, mean_diameter
 
 HISTORIES = ("point", "rain")
 DROP_D = 2.0     # a grain this far (mean diameters) below the ground discs' centres has left the base
@@ -104,7 +104,7 @@ def construct(cfg, history, member, point_half_width=None, log=None, checkpoint=
 
 
 def pile_dataset(cfg, history, member, scene, rec, ground, eq, frames, point_half_width=None, info=None):
-    """One pile's file: :func:`ncd.figures.pile.construction_dataset` plus the frames,
+    """One pile's file: :func:`ncd.scenes.pile.construction_dataset` plus the frames,
     the base half-width and the flank fits, the insertion index of every grain and the
     count of grains removed off the base (``info`` of :func:`construct`)."""
     ds = construction_dataset(cfg, scene, rec, ground, eq)
@@ -134,7 +134,7 @@ def ground_forces(ds):
     """``(x, fx, fy)`` of the ground contacts of a pile file (history forces, N).
 
     A contact with ``body_b`` not a grain is a ground contact; the force on the
-    grain is ``f_n n + f_t t`` with ``t = (-n_y, n_x)`` (:mod:`ncd.contacts`)."""
+    grain is ``f_n n + f_t t`` with ``t = (-n_y, n_x)`` (:mod:`ncd.core.contacts`)."""
     nm = ds.sizes["grain"]
     b = ds["body_b"].values
     g = (b < 0) | (b >= nm)

@@ -12,8 +12,8 @@ Per pile (history forces: the warm-started equilibrium test of its final state):
   ``M`` the mean of the largest ``p`` on either side within ``dip_flank``: > 0 a dip
   under the apex, < 0 a hump;
 * arching: the resultant across vertical cuts at ``x = ± q L`` (whole column,
-  :func:`ncd.figures.cuts.cut_matrix`), its angle below the horizontal and its
-  deviation from the pile's own flank slope (:func:`ncd.figures.cuts.flank_angles`);
+  :func:`ncd.scenes.cuts.cut_matrix`), its angle below the horizontal and its
+  deviation from the pile's own flank slope (:func:`ncd.scenes.cuts.flank_angles`);
   a cut crossing no contact (near a toe) has no resultant direction: NaN, left out of
   the statistics over piles (its count is ``cut_count``).
 
@@ -32,10 +32,10 @@ import warnings
 import numpy as np
 import xarray as xr
 
-from . import cuts as cm
-from .history import HISTORIES, ground_forces
-from .pile import equilibrium_problem, final_scene
-from .sources import mean_diameter
+from ncd.figures.history import HISTORIES, ground_forces
+from ncd.scenes import cuts as cm
+from ncd.scenes.pile import equilibrium_problem, final_scene
+from ncd.scenes.sources import mean_diameter
 
 CERTIFIED_DEG = 1e-6   # an exact angle range is certified when its error bound (angle_bound) is below this
 

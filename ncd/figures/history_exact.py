@@ -1,7 +1,7 @@
 """Exact angle ranges at the arching cuts of a pile of fig4_history (issue 16, item 3).
 
 For one pile file, over the set A ∩ C of its final configuration (every force state
-that balances the weights within the Coulomb cones, :class:`ncd.exact_set.ExactSet`,
+that balances the weights within the Coulomb cones, :class:`ncd.exact.exact_set.ExactSet`,
 HiGHS LPs), the exact range of the angle below the horizontal of the resultant across
 each arching cut of :func:`ncd.figures.history_analysis.pile_measures` (``x = ± q L``,
 whole column): a linear-fractional program, solved by Dinkelbach's iteration with a
@@ -14,10 +14,10 @@ import time
 import numpy as np
 import xarray as xr
 
-from . import cuts as cm
-from .history_analysis import norm_length
-from ..exact_set import ExactSet
-from .pile_exact import pile_problem
+from ncd.exact.exact_set import ExactSet
+from ncd.figures.history_analysis import norm_length
+from ncd.scenes import cuts as cm
+from ncd.scenes.pile import pile_problem
 
 
 def cut_specs(cfg, ds):

@@ -19,7 +19,8 @@ profiles compare directly.  Every band resamples piles, never runs of one pile.
 import numpy as np
 import xarray as xr
 
-from .history_analysis import bootstrap_index, permutation_p
+from ncd.figures.history_analysis import bootstrap_index, permutation_p
+from ncd.figures.history_plots import COLORS
 
 
 def _pile_arching(an):
@@ -135,7 +136,6 @@ def figure(sz):
     pile, per history with bands over piles; (d) median deviation against cut position per size."""
     import matplotlib.pyplot as plt
 
-    from .history_plots import COLORS
     fig, axes = plt.subplots(1, 4, figsize=(14, 3.6), constrained_layout=True)
     n = sz.grains.values
     k0 = sz.kernel.values[0]

@@ -5,9 +5,9 @@ horizontal ground (a row of fixed discs) and the whole construction is
 simulated with warm-started NLGS (the antecedent impulses as initial guess,
 section 2) until the equilibrium test of section 2 passes.  The final
 arrangement is then explored by NLGS runs from the zero guess with random
-review orders (section 5); the measures of :mod:`ncd.figures.cuts` (cut
+review orders (section 5); the measures of :mod:`ncd.scenes.cuts` (cut
 resultants, ground pressure) are kept per run, with the run's outcome
-(:func:`ncd.convergence.classify`: converged at rest, converged in motion, or not;
+(:func:`ncd.solver.convergence.classify`: converged at rest, converged in motion, or not;
 the observable is the default cut resultant and the binned ground pressure).
 """
 
@@ -15,129 +15,14 @@ import numpy as np
 import scipy.sparse as sp
 import xarray as xr
 
-import ncd
-from ncd.explore import explore, member_rng
-from ncd.io import provenance
-from ncd.model import SimulationError
-from ncd.pipeline import settings as solver_settings
-
-from . import cuts as cm
-from .construction import build, carry_warm  # noqa: F401 (carry_warm: used by ncd.studies.peer)
-from .sources import PointSource as Source, mean_diameter  # noqa: F401 (the original names)
-
-
-def make_ground(cfg, rng):
-    """A rough ground: touching fixed discs, centres on ``y = 0``, radii uniform,
-    spanning ``|x| <= half_width_d`` mean diameters."""
-    g = cfg["ground"]
-    half = g["half_width_d"] * mean_diameter(cfg)
-    xs, rs = [], []
-    x = -half
-    while x < half:
-        r = rng.uniform(g["radius_min"], g["radius_max"])
-        xs.append(x + r)
-        rs.append(r)
-        x += 2 * r
-    return np.column_stack([xs, np.zeros(len(xs))]), np.array(rs)
-
-
-def pile_scene(cfg, pos, radius, ground_pos, ground_radius, vel=None, spin=None, angle=None):
-    """The scene: grains, ground discs, gravity, friction; no walls, no restitution."""
-    c = cfg["construction"]
-    return ncd.make_scene(pos, radius, cfg["grains"]["density"], obstacle_pos=ground_pos,
-                          obstacle_radius=ground_radius, gravity=(0.0, -cfg["gravity"]), mu=cfg["mu"],
-                          mu_obstacle=cfg["mu_ground"], vel=vel, spin=spin, angle=angle,
-                          overlap_tolerance=c["overlap_tolerance"])
-
-
-def construct(cfg, log=None, log_every=10.0, checkpoint=None, checkpoint_every=0, frame_every=0):
-    """Pour ``grains.n`` discs from the localized source and step until at rest
-    (section 2's equilibrium test); :func:`ncd.figures.construction.build` is the loop.
-
-    Returns ``(scene, record, ground, eq)``: the final scene, the per-step record
-    (dict of arrays), the ground discs ``(pos, radius)`` and the warm-started
-    :class:`ncd.EquilibriumResult` of the final state (the history forces); with
-    ``frame_every > 0`` also the frames ``(frame_steps, frames)``.
-    Raises :class:`SimulationError` if a grain leaves the ground or if the pile is not
-    at rest after ``max_steps``.  Progress goes to ``log`` every ``log_every`` seconds.
-    """
-    rng = member_rng(0, cfg["seed"])
-    ground = make_ground(cfg, rng)
-    source = Source(cfg, rng, float(np.mean(ground[1])))
-    factory = lambda p, r, v, w, a: pile_scene(cfg, p, r, *ground, vel=v, spin=w, angle=a)  # noqa: E731
-    scene, rec, eq, frames = build(cfg, ground, source, factory, log, log_every, checkpoint, checkpoint_every,
-                                   frame_every)
-    return (scene, rec, ground, eq) + ((frames,) if frame_every > 0 else ())
-
-
-def construction_dataset(cfg, scene, rec, ground, eq):
-    """construction.nc: the per-step record, the final state and its history forces."""
-    nm = scene.n_mobile
-    c = eq.contacts
-    h = cfg["h"]
-    ds = xr.Dataset(
-        {
-            **{k: ("step", v) for k, v in rec.items()},
-            "x": ("grain", scene.pos[:nm, 0]), "y": ("grain", scene.pos[:nm, 1]),
-            "radius": ("grain", scene.radius[:nm]), "mass": ("grain", scene.mass[:nm]),
-            "vx": ("grain", scene.vel[:nm, 0]), "vy": ("grain", scene.vel[:nm, 1]),
-            "spin": ("grain", scene.spin[:nm]), "angle": ("grain", scene.angle[:nm]),
-            "ground_x": ("ground", ground[0][:, 0]), "ground_y": ("ground", ground[0][:, 1]),
-            "ground_radius": ("ground", ground[1]),
-            "body_a": ("contact", c.body_a), "body_b": ("contact", c.body_b), "key": ("contact", c.key),
-            "normal_x": ("contact", c.normal[:, 0]), "normal_y": ("contact", c.normal[:, 1]),
-            "point_x": ("contact", c.point[:, 0]), "point_y": ("contact", c.point[:, 1]),
-            "gap": ("contact", c.gap),
-            "force_n": ("contact", eq.forces[:, 0]), "force_t": ("contact", eq.forces[:, 1]),
-        },
-        coords={"step": np.arange(1, len(rec["time"]) + 1)},
-        attrs=provenance(cfg, solver_settings(cfg["construction"]["settings"]), h=h,
-                         mean_diameter=mean_diameter(cfg), n_grains=nm, n_steps=len(rec["time"]),
-                         weight=float(np.sum(scene.mass[:nm]) * cfg["gravity"]),
-                         at_rest=eq.at_rest, eq_max_velocity=eq.max_velocity, eq_sweeps=eq.result.sweeps,
-                         eq_residual=eq.result.residual, eq_converged=eq.result.converged,
-                         eq_solver_tol=cfg["construction"]["equilibrium"]["tol"]),
-    )
-    ds["wall_time"].attrs["note"] = "measured seconds per step (the only non-reproducible variable)"
-    ds["force_n"].attrs["note"] = "history forces: warm-started equilibrium test of the final state, r = s/h"
-    return ds
-
-
-def final_scene(cfg, construction):
-    """Rebuild the final scene (at rest) from construction.nc."""
-    ds = construction
-    pos = np.column_stack([ds["x"].values, ds["y"].values])
-    gpos = np.column_stack([ds["ground_x"].values, ds["ground_y"].values])
-    return pile_scene(cfg, pos, ds["radius"].values, gpos, ds["ground_radius"].values,
-                      angle=ds["angle"].values)
-
-
-def equilibrium_problem(cfg, scene, construction=None):
-    """The one-step problem from rest (theta = 1, as in :func:`ncd.equilibrium_test`);
-    checks that its contacts are those of the stored history forces."""
-    problem = ncd.prepare_step(scene, cfg["h"], 1.0, vel=np.zeros_like(scene.vel),
-                               spin=np.zeros_like(scene.spin))
-    if construction is not None and not np.array_equal(problem.contacts.key, construction["key"].values):
-        raise SimulationError("the contacts of the rebuilt final state differ from construction.nc")
-    return problem
-
-
-def _cut_specs(ds):
-    """``[(x_cut, outer, y_lo, y_hi)]`` of the cuts of cuts.nc."""
-    return list(zip(ds["cut_x"].values, ds["outer"].values.astype(int), ds["y_lo"].values, ds["y_hi"].values))
-
-
-def free_surface(cfg, pos, radius, y0):
-    """``(xs, height, fits, m, bin)``: the free-surface profile above ``y0`` in bins of
-    ``surface.bin_d`` mean diameters (``2 m`` bins centred at ``xs``) and its flank fits
-    between ``surface.fit_range`` (:func:`ncd.figures.cuts.fit_flanks`)."""
-    d = mean_diameter(cfg)
-    sb = cfg["surface"]["bin_d"] * d
-    m = int(np.ceil((np.abs(pos[:, 0]).max() + d) / sb))
-    edges = np.arange(-m, m + 1) * sb
-    xs = 0.5 * (edges[1:] + edges[:-1])
-    height = cm.surface_profile(pos, radius, edges) - y0
-    return xs, height, cm.fit_flanks(xs, height, 0.0, cfg["surface"]["fit_range"]), m, sb
+from ncd.dynamics.explore import explore
+from ncd.io.netcdf import provenance
+from ncd.pipeline.workflow import Progress
+from ncd.scenes import cuts as cm
+from ncd.scenes.pile import cut_specs, equilibrium_problem, final_scene, free_surface
+from ncd.scenes.sources import mean_diameter
+from ncd.solver.convergence import MAX_SPEED_ATTRS, outcome_attrs
+from ncd.solver.settings import SolverSettings
 
 
 def cuts_dataset(cfg, construction):
@@ -225,16 +110,15 @@ def ensemble_shard(cfg, construction, cuts, members, tolerances, root_seed, log=
     (total and per bin), the end-of-step velocities' summary and the solver record.
 
     ``finish`` (default ``cfg["ensemble"]["finish"]``): "active_set" hands each run over
-    at ``tol`` to the finishing stage (:mod:`ncd.finish`, to ``finish_tol``), an exact
+    at ``tol`` to the finishing stage (:mod:`ncd.solver.finish`, to ``finish_tol``), an exact
     solution whose observable has nothing left to settle, so the observable is not
     tracked; "none": plain NLGS, converged only when the observable has settled too."""
-    from ncd.pipeline import Progress
     e = cfg["ensemble"]
     h, g = cfg["h"], cfg["gravity"]
     scene = final_scene(cfg, construction)
     problem = equilibrium_problem(cfg, scene, construction)
     c, nm = problem.contacts, scene.n_mobile
-    C, _ = cm.cut_matrix(c, scene.pos, nm, _cut_specs(cuts))
+    C, _ = cm.cut_matrix(c, scene.pos, nm, cut_specs(cuts))
     edges = np.append(cuts["bin_lo"].values, cuts["bin_hi"].values[-1])
     G = cm.ground_matrix(c, nm, edges)
     members = np.asarray(members, dtype=np.int64)
@@ -248,7 +132,7 @@ def ensemble_shard(cfg, construction, cuts, members, tolerances, root_seed, log=
     finish = e.get("finish", "none") if finish is None else finish
     observe = _observable(cfg, scene, c, C, edges) if finish == "none" else None
     for j, tol in enumerate(tolerances):
-        settings = ncd.SolverSettings(tol=float(tol), max_sweeps=e["max_sweeps"], check_every=e["check_every"],
+        settings = SolverSettings(tol=float(tol), max_sweeps=e["max_sweeps"], check_every=e["check_every"],
                                       finish=finish, finish_tol=e.get("finish_tol", 1e-10),
                                       observable_tol=e.get("observable_tol", 1e-6))
         prog = Progress(log, len(members), f"tol {tol:g}") if log is not None else None
@@ -283,7 +167,6 @@ def ensemble_shard(cfg, construction, cuts, members, tolerances, root_seed, log=
                                      moving_tol=e["moving_tol"], init="zero", review="random", finish=finish,
                                      finish_tol=e.get("finish_tol", 1e-10) if finish != "none" else np.nan))
     ds["max_velocity"].attrs["units"] = "g h (largest |u_f| or |r w_f| over grains; 0 at equilibrium)"
-    from ncd.convergence import MAX_SPEED_ATTRS, outcome_attrs
     ds["outcome"].attrs.update(outcome_attrs())
     ds["max_speed"].attrs.update(MAX_SPEED_ATTRS)
     ds["observable_change"].attrs.update(units="1", long_name="largest relative change of the observable (default "

@@ -4,7 +4,7 @@ The equilibrium forces of the final arrangement form the polytope
 ``A ∩ C = {r : H r + F = 0, |r_t| <= mu r_n}``.  Every quantity of the figure is a
 linear map of ``r`` (cut resultants, ground forces), so its exact range over A ∩ C
 is given by linear programs on one warm-started HiGHS model
-(:class:`ncd.exact_set.ExactSet`).  :func:`exact_dataset` writes ``exact.nc``:
+(:class:`ncd.exact.exact_set.ExactSet`).  :func:`exact_dataset` writes ``exact.nc``:
 
 * (a) the exact polygon of the cut resultant (:meth:`ExactSet.polygon`) for the
   default cut and the cuts moved by ``± shift_d``;
@@ -13,7 +13,7 @@ is given by linear programs on one warm-started HiGHS model
   certified, no polygon needed) and of its vertical component (a state *arches*
   across a cut when the inner side pushes the bank downward, ``F_y < 0``: every
   admissible state arches iff ``max F_y < 0``);
-* (c) the exact range of the ground pressure (:mod:`ncd.figures.pressure`) and the
+* (c) the exact range of the ground pressure (:mod:`ncd.scenes.pressure`) and the
   dip verdict.
 """
 import time
@@ -21,23 +21,16 @@ import time
 import numpy as np
 import xarray as xr
 
-from ..contacts import h_matrix
-from ..exact_set import ExactSet
-from ..io import provenance
-from ..polygon import hull_area, outside_distance, polygon_area
-from . import cuts as cm
+from ncd.exact.exact_set import ExactSet
+from ncd.exact.polygon import hull_area, outside_distance, polygon_area
+from ncd.io.netcdf import provenance
+from ncd.scenes import cuts as cm
+from ncd.scenes import pressure as pm
+from ncd.scenes.pile import cut_specs, pile_problem
+from ncd.scenes.sources import mean_diameter
+from ncd.solver.convergence import OUTCOMES, REST
 
 __all__ = ["ExactSet", "exact_dataset", "pile_problem", "resultant_angle"]
-
-def pile_problem(cfg, construction):
-    """``(scene, contacts, H, F, mu)`` of the final configuration: ``H r + F = 0`` (forces)."""
-    from .pile import equilibrium_problem, final_scene
-    scene = final_scene(cfg, construction)
-    c = equilibrium_problem(cfg, scene, construction).contacts
-    nm = scene.n_mobile
-    F = np.zeros((nm, 3))
-    F[:, :2] = scene.mass[:nm, None] * scene.gravity[None, :]
-    return scene, c, h_matrix(scene, c), F.ravel(), c.mu
 
 
 def resultant_angle(vertices, outer):
@@ -64,8 +57,6 @@ def _pad(arrays, width):
 def exact_dataset(cfg, construction, cuts, log=None):
     """exact.nc: polygons of the default and shifted cuts, the exact angle range and
     arching of every cut, the exact ground-pressure bands and the dip verdict."""
-    from . import pressure as pm
-    from .pile import _cut_specs, mean_diameter
     ex = cfg["exact"]
     scene, c, H, F, mu = pile_problem(cfg, construction)
     nm, d = scene.n_mobile, mean_diameter(cfg)
@@ -73,7 +64,7 @@ def exact_dataset(cfg, construction, cuts, log=None):
     history = np.column_stack([construction["force_n"].values, construction["force_t"].values]).ravel()
     t0 = time.perf_counter()
     es = ExactSet(H, F, mu)
-    C, _ = cm.cut_matrix(c, scene.pos, nm, _cut_specs(cuts))
+    C, _ = cm.cut_matrix(c, scene.pos, nm, cut_specs(cuts))
     kind, outer = cuts["kind"].values, cuts["outer"].values
     hist_F = (C @ history).reshape(-1, 2)
     hist_angle = cm.flank_angles(hist_F[:, 0], hist_F[:, 1], outer, 0.0)[0]     # NaN: a cut crossing no contact
@@ -192,7 +183,6 @@ def polygon_of(exact, k):
 
 def rest_mask(ens):
     """Runs converged at rest (outcome 1), the only ones drawn in a cloud."""
-    from ..convergence import REST
     return ens["outcome"].values == REST
 
 
@@ -219,7 +209,6 @@ def draw_cloud(ax, exact, ens, k, mask, color="C0", label=None):
 def exact_text(exact, ens, cuts):
     """Markdown from exact.nc and the ensemble: outcomes, polygons and coverage of the
     default and shifted cuts, arching over all cuts, the ground-pressure dip verdict."""
-    from ..convergence import OUTCOMES
     a, W = exact.attrs, float(exact.attrs["weight"])
     oc = ens["outcome"].values
     counts = {OUTCOMES[k]: int((oc == k).sum()) for k in sorted(OUTCOMES)}

@@ -30,12 +30,12 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
-from ..explore import member_rng, shard_members
-from ..io import provenance
-from ..pipeline import settings as solver_settings
-from ..scene import make_scene
-from ..stepper import prepare_step, solve_problem, step
-from ..model import InputError
+from ncd.core.errors import InputError
+from ncd.core.scene import make_scene
+from ncd.dynamics.explore import member_rng, shard_members
+from ncd.dynamics.stepper import prepare_step, solve_problem, step
+from ncd.io.netcdf import provenance
+from ncd.pipeline.workflow import settings as solver_settings
 
 CONTACTS = ("left", "right")
 OUTCOMES = "-1: not classified (not converged, or neither falling nor at rest); 0: falls; 1: wedged"

@@ -1,6 +1,6 @@
-"""Studies of the solver itself (issue 5): stability on stiff and extreme cases and
+"""Layer 8, studies: the solver itself: stability on stiff and extreme cases and
 work-precision (error against run time), Contact Dynamics against the soft-contact
-molecular-dynamics baseline :mod:`ncd.md`.
+molecular-dynamics baseline :mod:`ncd.dynamics.md`.
 
 * :mod:`ncd.studies.scenes` -- small scenes built here (not taken from the figures);
 * :mod:`ncd.studies.stability` -- the stability table;

@@ -9,7 +9,7 @@
 * :func:`sweeps_table`: the sweeps NLGS needs to reach a fixed tolerance
   as N grows, from the zero guess and from the warm start;
 * :func:`ensemble_table`: an ensemble of NLGS runs on 1 and on 2 threads
-  (:func:`ncd.explore.run_parallel`): speed-up and bit-for-bit equality;
+  (:func:`ncd.dynamics.explore.run_parallel`): speed-up and bit-for-bit equality;
 * :func:`startup`: ``import ncd`` and a first step in a fresh interpreter
   with a warm numba cache;
 * :func:`rule_times`: the wall time and memory of every pipeline rule, read
@@ -33,13 +33,14 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from .. import nlgs
-from ..contacts import detect_contacts
-from ..explore import explore
-from ..finish_bench import settings_of
-from ..nlgs import SolverSettings
-from ..scene import make_scene
-from ..stepper import initial_guess, prepare_step, solve_problem, step
+from ncd.core.contacts import detect_contacts
+from ncd.core.scene import make_scene
+from ncd.dynamics.explore import explore
+from ncd.dynamics.stepper import initial_guess, prepare_step, solve_problem, step
+from ncd.solver.kernels import sweep_discs
+from ncd.solver.pack import pack_problem
+from ncd.solver.settings import SolverSettings
+from ncd.studies.finish_bench import settings_of
 
 C_SOURCE = Path(__file__).with_name("c_sweep.c")
 H = 1e-3
@@ -98,9 +99,9 @@ class PeakMemory:
 
 
 def packed_problem(scene, problem):
-    """The flat arrays of the NLGS kernel (:func:`ncd.nlgs.pack_problem`) of a prepared step."""
+    """The flat arrays of the NLGS kernel (:func:`ncd.solver.pack.pack_problem`) of a prepared step."""
     c = problem.contacts
-    pair, coef, body = nlgs.pack_problem(c.body_a, c.body_b, c.normal, c.arm_a, c.arm_b, problem.W,
+    pair, coef, body = pack_problem(c.body_a, c.body_b, c.normal, c.arm_a, c.arm_b, problem.W,
                                          c.mu, problem.bias, scene.inv_mass, scene.inv_inertia,
                                          problem.free_vel, problem.free_spin)
     return pair.ravel(), coef.ravel(), body.ravel()
@@ -125,7 +126,7 @@ def nlgs_sweep_cost(scene, problem, sweeps, repeat, order=None):
         b, imp = body.copy(), np.zeros(2 * n)
         t0 = time.perf_counter()
         for _ in range(sweeps):
-            nlgs._sweep_discs((pair, coef, b, imp), order, status)
+            sweep_discs((pair, coef, b, imp), order, status)
         best = min(best, time.perf_counter() - t0)
     return best / sweeps, imp
 
@@ -251,7 +252,7 @@ def tolerance_table(cfg, log=None):
     """Time to tolerance, plain NLGS, NLGS + finishing stage and Anderson-accelerated NLGS side by side: one step
     from rest of each dense packing, zero guess, identity review order.  Plain NLGS runs
     to each ``tolerances`` value; the finished run hands over at ``handoff`` and polishes
-    to the same value (``finish="active_set"``, :mod:`ncd.finish`).  -> Dataset
+    to the same value (``finish="active_set"``, :mod:`ncd.solver.finish`).  -> Dataset
     (size, solver, tol): seconds, sweeps, residual, converged, finish rounds."""
     sizes, tols, methods = cfg["sizes"], cfg["tolerances"], ["nlgs", "nlgs+finish", "anderson"]
     shape = (len(sizes), len(methods), len(tols))

@@ -31,12 +31,14 @@ import time
 import numpy as np
 import xarray as xr
 
-import ncd
-from ncd.detection import disc_pairs
-from ncd.explore import member_rng
-from ncd.figures.pile import carry_warm
-from ncd.io import provenance
-from ncd.model import InputError
+from ncd.core.detection import disc_pairs
+from ncd.core.errors import InputError
+from ncd.core.scene import make_scene
+from ncd.dynamics.explore import member_rng
+from ncd.dynamics.stepper import prepare_step, step
+from ncd.io.netcdf import provenance
+from ncd.scenes.construction import carry_warm
+from ncd.solver.settings import SolverSettings
 
 ENGINES = ("ncd", "pymunk")
 
@@ -78,7 +80,7 @@ def check_cfg(cfg):
 
 def solver_settings(cfg):
     """Exactly ``iterations`` NLGS sweeps (the tolerance is never met)."""
-    return ncd.SolverSettings(tol=1e-300, max_sweeps=cfg["iterations"], check_every=cfg["iterations"])
+    return SolverSettings(tol=1e-300, max_sweeps=cfg["iterations"], check_every=cfg["iterations"])
 
 
 def build(cfg):
@@ -137,7 +139,7 @@ class NcdEngine:
         def grow(name, tail):       # the mobile part of the old state, plus the new disc
             return np.concatenate([getattr(old, name)[:n], tail]) if n else np.asarray(tail, float)
 
-        new = ncd.make_scene(grow("pos", [xy]), grow("radius", [r]), c["density"],
+        new = make_scene(grow("pos", [xy]), grow("radius", [r]), c["density"],
                              obstacle_pos=self.geo["ground_pos"], obstacle_radius=self.geo["ground_radius"],
                              walls=self.walls, gravity=(0.0, -c["gravity"]), mu=c["mu"],
                              vel=grow("vel", [[0.0, 0.0]]), spin=grow("spin", [0.0]),
@@ -151,7 +153,7 @@ class NcdEngine:
         if last:
             self.before = self.scene.copy()
         t0 = time.perf_counter()
-        self.report = ncd.step(self.scene, self.cfg["h"], settings=self.settings)
+        self.report = step(self.scene, self.cfg["h"], settings=self.settings)
         return time.perf_counter() - t0
 
     def state(self):
@@ -161,7 +163,7 @@ class NcdEngine:
 
     def contact_forces(self):
         """Last step: ``(f_n, f_t, on_obstacle, vertical impulse on the mobile disc)``."""
-        problem = ncd.prepare_step(self.before, self.cfg["h"])
+        problem = prepare_step(self.before, self.cfg["h"])
         c, s = problem.contacts, self.scene
         if not np.array_equal(c.key, s.prev_keys):
             raise RuntimeError("the rebuilt last-step contacts differ from the stepped ones")

@@ -5,8 +5,8 @@ Length unit: the disc radius ``r`` (default 0.01 m), density 1 kg/m^2 (2-D), gra
 """
 import numpy as np
 
-from ..scene import make_scene
-from ..stepper import kinetic_energy, step
+from ncd.core.scene import make_scene
+from ncd.dynamics.stepper import kinetic_energy, step
 
 G = 9.81
 

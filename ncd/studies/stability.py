@@ -20,11 +20,11 @@ import time
 import numpy as np
 import xarray as xr
 
-from ..md import MD, MDParams, critical_step, potential_energy
-from ..model import SimulationError
-from ..nlgs import SolverSettings
-from ..stepper import kinetic_energy, step
-from . import scenes
+from ncd.core.errors import SimulationError
+from ncd.dynamics.md import MD, MDParams, critical_step, potential_energy
+from ncd.dynamics.stepper import kinetic_energy, step
+from ncd.solver.settings import SolverSettings
+from ncd.studies import scenes
 
 KINDS = ("stack", "box", "chain", "impact_wall", "impact_disc", "hexagonal")
 
@@ -126,7 +126,7 @@ def run_cd(s, h, n_steps, settings, speed_limit, n_trace, gap_tolerance=None):
 
 
 def run_md(s, params, h, n_steps, speed_limit, n_trace):
-    """Soft-contact run (:class:`ncd.md.MD`); same diagnostics as :func:`run_cd`."""
+    """Soft-contact run (:class:`ncd.dynamics.md.MD`); same diagnostics as :func:`run_cd`."""
     md = MD(s, params)
     e0 = _energy(s, md)
     every = max(1, n_steps // n_trace)

@@ -1,12 +1,12 @@
 """Work-precision: error against run time for the NLGS at one step and for time
-integration, Contact Dynamics (CD) against the soft-contact baseline (MD, :mod:`ncd.md`).
+integration, Contact Dynamics (CD) against the soft-contact baseline (MD, :mod:`ncd.dynamics.md`).
 
 NLGS at one step (Moreau 2005, section 2: "reviewing contacts cyclically again and
 again ... until some convergence criterium is met", from a zero or a warm initial
 guess).  On the core problem ``U = W s + q`` of one step of a state built here, each
 setting (initial guess, stopping criterion, tolerance) gives a run with its wall time
 (best of ``repeats``), sweeps, relative natural-map residual
-``|s - proj_K(s - rho U~)| / max(|s|, |rho q|)`` (:mod:`ncd.nlgs`) and its distance to
+``|s - proj_K(s - rho U~)| / max(|s|, |rho q|)`` (:mod:`ncd.solver.nlgs`) and its distance to
 the limit of the same iteration run to ``reference.tol``:
 
     err_s = |s - s*| / |s*|,   err_u = max |u_f - u_f*| / (|g| h)   (spins times radii).
@@ -31,11 +31,11 @@ import time
 import numpy as np
 import xarray as xr
 
-from ..md import MD, MDParams, critical_step, external_force
-from ..nlgs import SolverSettings
-from ..scene import make_scene
-from ..stepper import initial_guess, prepare_step, solve_problem, step
-from . import scenes
+from ncd.core.scene import make_scene
+from ncd.dynamics.md import MD, MDParams, critical_step, external_force
+from ncd.dynamics.stepper import initial_guess, prepare_step, solve_problem, step
+from ncd.solver.settings import SolverSettings
+from ncd.studies import scenes
 
 
 # ------------------------------------------------------------------ NLGS at one step
@@ -64,17 +64,17 @@ def _velocity_error(s, problem, vel, spin, vel_ref, spin_ref):
 
 
 FINISH_HANDOFF = 1e-4     # NLGS tolerance handed to the finishing stage (criterion "finish")
-ANDERSON_MEMORY = 20      # criterion "anderson": Anderson-accelerated NLGS (ncd.anderson), residual criterion
+ANDERSON_MEMORY = 20      # criterion "anderson": Anderson-accelerated NLGS (ncd.solver.anderson), residual criterion
 
 
 def nlgs_work_precision(s, h, tols, inits, criteria, reference, repeats, max_sweeps):
     """All settings on the core problem of the next step of ``s``; a Dataset with
     dimensions ``(init, criterion, tol)``.
     Criterion ``"finish"``: NLGS to ``max(tol, FINISH_HANDOFF)``, then the finishing stage
-    (:mod:`ncd.finish`: NLGS while its rate is good, else the projection on its statuses'
+    (:mod:`ncd.solver.finish`: NLGS while its rate is good, else the projection on its statuses'
     polyhedron) to ``tol``.  Criterion ``"anderson"``: Anderson-accelerated NLGS
-    (:mod:`ncd.anderson`, memory :data:`ANDERSON_MEMORY`) to ``tol`` on the residual;
-    ``"anderson_local"``: the same with local exact solves where it stalls (:mod:`ncd.local_exact`)."""
+    (:mod:`ncd.solver.anderson`, memory :data:`ANDERSON_MEMORY`) to ``tol`` on the residual;
+    ``"anderson_local"``: the same with local exact solves where it stalls (:mod:`ncd.solver.local_exact`)."""
     problem = prepare_step(s, h)
     guesses = {init: initial_guess(s, problem, init) for init in inits}
     ref_settings = SolverSettings(tol=reference["tol"], max_sweeps=reference["max_sweeps"])

@@ -141,6 +141,7 @@ rule bench_notebook:
         rules="results/bench/rules.nc",
         notebook=notebook_file("bench"),
         notebook_py=notebook_file("bench", "py"),
+        pages=page_sources("notebook"),
     output:
         png=figure_output("bench", "png"),
         pdf=figure_output("bench", "pdf"),

@@ -12,7 +12,8 @@ import glob
 import os
 from pathlib import Path
 
-from ncd.configcheck import check_config
+from ncd.figures import FIGURE_MODULES
+from ncd.pipeline.config import check_config
 
 ROOT = Path(workflow.basedir)
 # Every rule input and output is relative to the working directory, so that a moved or
@@ -28,44 +29,43 @@ FIGURES = [f for f in ("fig1_wedged", "fig2_slope", "fig3_equilibrium", "fig4_pi
 
 # Every config section (a missing figure section included) is checked here, before any
 # job: its schema (integers that are integers), finite numbers everywhere, and the
-# cross-field constraints of ncd/configcheck.py; errors name section and key.
+# cross-field constraints of ncd/pipeline/config.py; errors name section and key.
 check_config(config, FIGURES, ROOT / "workflow" / "schemas")
 
-# Threads of an ensemble rule: its NLGS runs are spread over them (ncd.explore.run_parallel,
+# Threads of an ensemble rule: its NLGS runs are spread over them (ncd.dynamics.explore.run_parallel,
 # results identical whatever the count); Snakemake lowers it to the cores it was given.
 ENSEMBLE_THREADS = 2
 
-# The sources a figure's simulation and exploration rules depend on: the solver core
-# (every module at the top of ncd/) and the figure's own modules, so that editing the
-# core reruns every figure and editing a figure's module reruns that figure only.
-NCD_CORE = sorted(str(REL / "ncd" / p.name) for p in (ROOT / "ncd").glob("*.py"))
-NCD_MODULES = {
-    "fig1_wedged": ["figures/__init__.py", "figures/wedged.py"],
-    "fig2_slope": ["figures/__init__.py", "figures/slope.py", "figures/slope_analysis.py", "figures/census.py",
-                   "figures/frames.py"],
-    "fig3_equilibrium": ["figures/__init__.py", "figures/equilibrium.py", "figures/faces.py"],
-    "fig4_pile": ["figures/__init__.py", "figures/pile.py", "figures/cuts.py", "figures/construction.py",
-                  "figures/sources.py", "figures/pile_exact.py", "figures/pressure.py"],
-    "fig4_history": ["figures/__init__.py", "figures/pile.py", "figures/cuts.py", "figures/construction.py",
-                     "figures/sources.py", "figures/history.py", "figures/history_analysis.py",
-                     "figures/history_plots.py", "figures/history_exact.py", "figures/history_size.py",
-                     "figures/pile_exact.py",
-                     "figures/pressure.py"],
-    "fig5_governing": ["figures/__init__.py", "figures/equilibrium.py", "figures/governing.py",
-                       "figures/governing_exact.py", "figures/governing_plot.py", "figures/governing_flow.py",
-                       "figures/governing_line.py", "figures/slope.py", "figures/slope_analysis.py",
-                       "figures/census.py", "figures/governing_summary.py", "figures/frames.py"],
-    "stability": ["studies/__init__.py", "studies/stability.py", "studies/scenes.py"],
-    "error_vs_runtime": ["studies/__init__.py", "studies/work_precision.py", "studies/scenes.py"],
-    "bench": ["studies/__init__.py", "studies/bench.py", "studies/peer.py", "studies/c_sweep.c",
-              "figures/__init__.py", "figures/pile.py", "figures/cuts.py", "figures/construction.py",
-              "figures/sources.py"],
+# The sources a figure's computing rules depend on: the layers below the figures (kernels,
+# data, exact sets, dynamics, workflow glue and the shared scenes, ncd/__init__.py) and the
+# figure's own modules (ncd.figures.FIGURE_MODULES, the table the layer test reads too).
+# Editing a solver module reruns every figure, a figure's module that figure only, and a
+# page module (ncd/pages) only the page rules that list it (page_sources).
+LOWER_LAYERS = ("core", "io", "solver", "exact", "dynamics", "pipeline", "scenes")
+NCD_CORE = sorted([str(REL / "ncd" / "__init__.py")]
+                  + [str(REL / p.relative_to(ROOT)) for layer in LOWER_LAYERS
+                     for p in (ROOT / "ncd" / layer).glob("*.py")])
+STUDY_MODULES = {
+    "stability": ("stability.py", "scenes.py"),
+    "error_vs_runtime": ("work_precision.py", "scenes.py"),
+    "bench": ("bench.py", "peer.py", "finish_bench.py", "c_sweep.c"),
 }
+# the page modules a page rule reads (notebook helpers, the HTML renderer, the index page)
+PAGE_MODULES = {"notebook": ("notebook.py",), "render": ("render.py",), "report": ("report.py",)}
 
 
 def ncd_sources(figure):
-    """Input files of a figure's computing rules: the solver core and the figure's modules."""
-    return NCD_CORE + [str(REL / "ncd" / m) for m in NCD_MODULES[figure]]
+    """Input files of a figure's computing rules: the lower layers and the figure's own modules."""
+    if figure in FIGURE_MODULES:
+        own = ["figures/__init__.py"] + [f"figures/{m}.py" for m in FIGURE_MODULES[figure]]
+    else:
+        own = ["studies/__init__.py"] + [f"studies/{m}" for m in STUDY_MODULES[figure]]
+    return NCD_CORE + [str(REL / "ncd" / m) for m in own]
+
+
+def page_sources(kind):
+    """The page modules of a page rule (never inputs of a computing rule)."""
+    return [str(REL / "ncd" / "pages" / m) for m in ("__init__.py",) + PAGE_MODULES[kind]]
 
 
 def section(figure):
@@ -91,7 +91,7 @@ def shard_files(figure, name, n_shards):
 
 def notebook_file(figure, ext="ipynb"):
     """The notebook of a figure: ``.ipynb`` (run by Snakemake) or ``.py`` (its jupytext pair;
-    an input too, so that editing it reruns the notebook, and ncd.notebook.paths stops the
+    an input too, so that editing it reruns the notebook, and ncd.pages.notebook.paths stops the
     run when the pair differs: `jupytext --sync` was forgotten)."""
     return str(REL / "notebooks" / f"{figure}.{ext}")
 

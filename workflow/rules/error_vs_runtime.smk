@@ -46,6 +46,7 @@ rule error_vs_runtime_notebook:
         integration="results/error_vs_runtime/integration.nc",
         notebook=notebook_file("error_vs_runtime"),
         notebook_py=notebook_file("error_vs_runtime", "py"),
+        pages=page_sources("notebook"),
     output:
         png=figure_output("error_vs_runtime", "png"),
         pdf=figure_output("error_vs_runtime", "pdf"),

@@ -88,6 +88,7 @@ rule fig1_wedged_notebook:
         sweep="results/fig1_wedged/sweep.nc",
         notebook=notebook_file("fig1_wedged"),
         notebook_py=notebook_file("fig1_wedged", "py"),
+        pages=page_sources("notebook"),
     output:
         png=figure_output("fig1_wedged", "png"),
         pdf=figure_output("fig1_wedged", "pdf"),

@@ -120,6 +120,7 @@ rule fig2_slope_notebook:
         census=f"{F2}/census.nc",
         notebook=notebook_file(FIG2),
         notebook_py=notebook_file(FIG2, "py"),
+        pages=page_sources("notebook"),
     output:
         png=figure_output(FIG2, "png"),
         pdf=figure_output(FIG2, "pdf"),

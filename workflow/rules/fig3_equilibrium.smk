@@ -113,6 +113,7 @@ rule fig3_equilibrium_notebook:
         uniform=f"{F3}/uniform.nc",
         notebook=notebook_file(FIG),
         notebook_py=notebook_file(FIG, "py"),
+        pages=page_sources("notebook"),
     output:
         png=figure_output(FIG, "png"),
         pdf=figure_output(FIG, "pdf"),

@@ -149,6 +149,7 @@ rule fig4_history_notebook:
         plots=str(REL / "ncd" / "figures" / "history_plots.py"),
         notebook=notebook_file(FIGH),
         notebook_py=notebook_file(FIGH, "py"),
+        pages=page_sources("notebook"),
     output:
         png=figure_output(FIGH, "png"),
         pdf=figure_output(FIGH, "pdf"),
@@ -197,6 +198,7 @@ rule fig4_history_size_notebook:
         plots=str(REL / "ncd" / "figures" / "history_size.py"),
         notebook=notebook_file(FHS),
         notebook_py=notebook_file(FHS, "py"),
+        pages=page_sources("notebook"),
     output:
         png=figure_output(FHS, "png"),
         pdf=figure_output(FHS, "pdf"),

@@ -126,6 +126,7 @@ rule fig4_pile_notebook:
         exact=f"{F4}/exact.nc",
         notebook=notebook_file(FIG4),
         notebook_py=notebook_file(FIG4, "py"),
+        pages=page_sources("notebook"),
     output:
         png=figure_output(FIG4, "png"),
         pdf=figure_output(FIG4, "pdf"),

@@ -95,6 +95,7 @@ rule fig5_governing_notebook:
         flows=f"{F5}/flows.nc",
         notebook=notebook_file(FIG),
         notebook_py=notebook_file(FIG, "py"),
+        pages=page_sources("notebook"),
     output:
         png=figure_output(FIG, "png"),
         pdf=figure_output(FIG, "pdf"),

@@ -21,10 +21,11 @@ rule html_mathjax:
 rule render_html:
     """Render an executed notebook (written by its figure's notebook rule) to a clean HTML
     page: no Snakemake preamble, code hidden behind a button, long tables folded, maths
-    typeset offline (ncd.render)."""
+    typeset offline (ncd.pages.render)."""
     input:
         png="results/figures/{figure}.png",
         mathjax="results/html/mathjax",
+        render=page_sources("render"),
     output:
         html="results/html/{figure}.html",
     params:

@@ -1,4 +1,4 @@
-# The reproduction page results/index.html (ncd/report.py): the paper's claims, one row
+# The reproduction page results/index.html (ncd/pages/report.py): the paper's claims, one row
 # each, with the number measured in this run, the verdict and a thumbnail linking to the
 # figure's page; the run's provenance; the run time of each figure.  Built by the default
 # target after every figure.
@@ -6,7 +6,8 @@
 
 rule index:
     input:
-        [figure_targets(f) for f in FIGURES],
+        figures=[figure_targets(f) for f in FIGURES],
+        report=page_sources("report"),
     output:
         "results/index.html",
     params:

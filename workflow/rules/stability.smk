@@ -27,6 +27,7 @@ rule stability_notebook:
         table="results/stability/table.nc",
         notebook=notebook_file("stability"),
         notebook_py=notebook_file("stability", "py"),
+        pages=page_sources("notebook"),
     output:
         png=figure_output("stability", "png"),
         pdf=figure_output("stability", "pdf"),

@@ -1,6 +1,6 @@
 """Core benchmark: sweep cost (numba and C), detection, step time, memory; start-up."""
-from ncd.io import provenance, write_dataset
-from ncd.pipeline import start
+from ncd.io.netcdf import provenance, write_dataset
+from ncd.pipeline.workflow import start
 from ncd.studies.bench import core_table, environment, startup
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)

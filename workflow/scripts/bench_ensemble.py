@@ -1,6 +1,6 @@
 """An NLGS ensemble on 1 and 2 threads: speed-up and bit-for-bit equality."""
-from ncd.io import provenance, write_dataset
-from ncd.pipeline import start
+from ncd.io.netcdf import provenance, write_dataset
+from ncd.pipeline.workflow import start
 from ncd.studies.bench import ensemble_table, environment
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)

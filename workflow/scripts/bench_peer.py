@@ -1,6 +1,6 @@
 """ncd and pymunk side by side on the same poured pile."""
-from ncd.io import write_dataset
-from ncd.pipeline import start
+from ncd.io.netcdf import write_dataset
+from ncd.pipeline.workflow import start
 from ncd.studies.bench import environment
 from ncd.studies.peer import compare
 

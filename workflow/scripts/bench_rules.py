@@ -1,8 +1,8 @@
 """Collect the wall time of every rule of the figures from their benchmark files."""
 import glob
 
-from ncd.io import write_dataset
-from ncd.pipeline import start
+from ncd.io.netcdf import write_dataset
+from ncd.pipeline.workflow import start
 from ncd.studies.bench import rule_times
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)

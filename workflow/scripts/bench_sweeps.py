@@ -1,6 +1,6 @@
 """Sweeps to a fixed tolerance against N (zero guess and warm start)."""
-from ncd.io import provenance, write_dataset
-from ncd.pipeline import start
+from ncd.io.netcdf import provenance, write_dataset
+from ncd.pipeline.workflow import start
 from ncd.studies.bench import environment, sweeps_table
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)

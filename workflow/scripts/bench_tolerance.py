@@ -5,12 +5,12 @@ review orders (-> tolerance_problems.nc)."""
 import numpy as np
 import xarray as xr
 
-from ncd.figures import pile, slope
-from ncd.finish_bench import FIELDS, METHODS, time_to_tolerance
-from ncd.io import provenance, write_dataset
-from ncd.pipeline import start
-from ncd.stepper import initial_guess, prepare_step
+from ncd.dynamics.stepper import initial_guess, prepare_step
+from ncd.io.netcdf import provenance, write_dataset
+from ncd.pipeline.workflow import start
+from ncd.scenes import pile, slope
 from ncd.studies.bench import environment, tolerance_table
+from ncd.studies.finish_bench import FIELDS, METHODS, time_to_tolerance
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)
 cfg = snakemake.params.config  # noqa: F821

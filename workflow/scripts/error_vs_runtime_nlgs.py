@@ -1,7 +1,7 @@
 """NLGS work-precision on the next step of each state built here."""
-from ncd.io import provenance, write_dataset
-from ncd.nlgs import SolverSettings
-from ncd.pipeline import start
+from ncd.io.netcdf import provenance, write_dataset
+from ncd.pipeline.workflow import start
+from ncd.solver.settings import SolverSettings
 from ncd.studies.work_precision import nlgs_table
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)

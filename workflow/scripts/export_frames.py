@@ -1,8 +1,8 @@
-"""VTK time series (ParaView) and an animation of a figure's stored frames (ncd.export)."""
+"""VTK time series (ParaView) and an animation of a figure's stored frames (ncd.io.export)."""
 import xarray as xr
 
-from ncd.export import animate, write_vtk
-from ncd.pipeline import start
+from ncd.io.export import animate, write_vtk
+from ncd.pipeline.workflow import start
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)
 ds = xr.load_dataset(snakemake.input[0])  # noqa: F821

@@ -1,7 +1,7 @@
 """One shard of the figure-1 exploration ensemble (ncd.figures.wedged.explore_shard)."""
 from ncd.figures.wedged import explore_shard
-from ncd.io import write_dataset
-from ncd.pipeline import Progress, start
+from ncd.io.netcdf import write_dataset
+from ncd.pipeline.workflow import Progress, start
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)
 shard, n = int(snakemake.wildcards.shard), int(snakemake.wildcards.n)  # noqa: F821

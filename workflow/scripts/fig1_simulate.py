@@ -1,7 +1,7 @@
 """The two evolutions of figure 1 (ncd.figures.wedged.evolutions)."""
 from ncd.figures.wedged import evolutions
-from ncd.io import write_dataset
-from ncd.pipeline import Progress, start
+from ncd.io.netcdf import write_dataset
+from ncd.pipeline.workflow import Progress, start
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)
 ds = evolutions(snakemake.params.config, Progress(log, 2, "evolutions"))  # noqa: F821

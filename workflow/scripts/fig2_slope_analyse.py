@@ -1,9 +1,9 @@
 """Figure 2: spreads, principal axes, solutions and verdict of the ensembles (measures.nc)."""
 import xarray as xr
 
-from ncd.figures import slope_analysis
-from ncd.io import write_dataset
-from ncd.pipeline import start
+from ncd.io.netcdf import write_dataset
+from ncd.pipeline.workflow import start
+from ncd.scenes import slope_analysis
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)
 traj = xr.load_dataset(snakemake.input.trajectory)  # noqa: F821

@@ -1,10 +1,10 @@
 """Figure 2: one shard of the zero-guess and warm-start NLGS runs at the investigated step."""
 import xarray as xr
 
-from ncd.explore import shard_members
-from ncd.figures import slope
-from ncd.io import write_dataset
-from ncd.pipeline import Progress, start
+from ncd.dynamics.explore import shard_members
+from ncd.io.netcdf import write_dataset
+from ncd.pipeline.workflow import Progress, start
+from ncd.scenes import slope
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)
 w = snakemake.wildcards  # noqa: F821

@@ -1,7 +1,7 @@
 """Figure 2: deposit, release and flow of the discs down the slope (trajectory.nc)."""
-from ncd.figures import slope
-from ncd.io import write_dataset
-from ncd.pipeline import Progress, start
+from ncd.io.netcdf import write_dataset
+from ncd.pipeline.workflow import Progress, start
+from ncd.scenes import slope
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)
 cfg = snakemake.params.config  # noqa: F821

@@ -1,7 +1,7 @@
 """Figure 3: deposit the discs until at rest and store the packing (state.nc)."""
 from ncd.figures import equilibrium
-from ncd.io import write_dataset
-from ncd.pipeline import Progress, start
+from ncd.io.netcdf import write_dataset
+from ncd.pipeline.workflow import Progress, start
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)
 cfg = snakemake.params.config  # noqa: F821

@@ -2,8 +2,8 @@
 import xarray as xr
 
 from ncd.figures import equilibrium
-from ncd.io import write_dataset
-from ncd.pipeline import start
+from ncd.io.netcdf import write_dataset
+from ncd.pipeline.workflow import start
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)
 state = xr.load_dataset(snakemake.input.state)  # noqa: F821

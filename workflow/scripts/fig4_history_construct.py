@@ -3,10 +3,10 @@ import os
 
 import xarray as xr
 
+from ncd.core.errors import InputError
 from ncd.figures import history
-from ncd.io import write_dataset
-from ncd.model import InputError
-from ncd.pipeline import start
+from ncd.io.netcdf import write_dataset
+from ncd.pipeline.workflow import start
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)
 cfg = snakemake.params.config  # noqa: F821

@@ -2,8 +2,8 @@
 import xarray as xr
 
 from ncd.figures import history_size
-from ncd.io import provenance, write_dataset
-from ncd.pipeline import start
+from ncd.io.netcdf import provenance, write_dataset
+from ncd.pipeline.workflow import start
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)
 analyses = [xr.load_dataset(p) for p in snakemake.input.analyses]  # noqa: F821

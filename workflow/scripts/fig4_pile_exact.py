@@ -2,8 +2,8 @@
 import xarray as xr
 
 from ncd.figures import pile_exact
-from ncd.io import write_dataset
-from ncd.pipeline import start
+from ncd.io.netcdf import write_dataset
+from ncd.pipeline.workflow import start
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)
 ds = pile_exact.exact_dataset(snakemake.params.config, xr.load_dataset(snakemake.input.construction),  # noqa: F821

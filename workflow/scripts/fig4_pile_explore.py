@@ -2,10 +2,10 @@
 ensemble's runs are finished (config ``ensemble.finish``), the tolerance study's are plain NLGS."""
 import xarray as xr
 
-from ncd.explore import shard_members
+from ncd.dynamics.explore import shard_members
 from ncd.figures import pile
-from ncd.io import write_dataset
-from ncd.pipeline import start
+from ncd.io.netcdf import write_dataset
+from ncd.pipeline.workflow import start
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)
 w = snakemake.wildcards  # noqa: F821

@@ -1,16 +1,16 @@
 """Figure 4: pour the pile and settle it until the warm equilibrium test passes (construction.nc,
 with frames every `construction.frame_every` steps)."""
-from ncd.figures import pile
-from ncd.figures.construction import add_frames
-from ncd.io import write_dataset
-from ncd.pipeline import start
+from ncd.io.netcdf import write_dataset
+from ncd.pipeline.workflow import start
+from ncd.scenes import pile
+from ncd.scenes.construction import add_frames
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)
 cfg = snakemake.params.config  # noqa: F821
 frame_every = cfg["construction"]["frame_every"]
 scene, record, ground, eq, *frames = pile.construct(cfg, log, frame_every=frame_every)
 ds = pile.construction_dataset(cfg, scene, record, ground, eq)
-if frame_every > 0:  # frames for ParaView and the animation (ncd.export, `snakemake export`)
+if frame_every > 0:  # frames for ParaView and the animation (ncd.io.export, `snakemake export`)
     add_frames(ds, frames[0], cfg["h"])
 write_dataset(ds, snakemake.output[0])  # noqa: F821
 d = ds.attrs["mean_diameter"]

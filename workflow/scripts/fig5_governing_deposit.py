@@ -1,7 +1,7 @@
 """Figure 5: the deposit of one seed, shared by every setting of that seed (shards/deposit_seed<s>.nc)."""
 from ncd.figures import governing_flow
-from ncd.io import write_dataset
-from ncd.pipeline import Progress, start
+from ncd.io.netcdf import write_dataset
+from ncd.pipeline.workflow import Progress, start
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)
 s = int(snakemake.wildcards.s)  # noqa: F821

@@ -2,8 +2,8 @@
 import xarray as xr
 
 from ncd.figures import governing
-from ncd.io import write_dataset
-from ncd.pipeline import Progress, start
+from ncd.io.netcdf import write_dataset
+from ncd.pipeline.workflow import Progress, start
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)
 packs = xr.load_dataset(snakemake.input.packs)  # noqa: F821

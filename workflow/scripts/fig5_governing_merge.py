@@ -1,7 +1,7 @@
 """Figure 5: merge the packing, exact and Unger shards into packings.nc."""
 from ncd.figures import governing
-from ncd.io import write_dataset
-from ncd.pipeline import start
+from ncd.io.netcdf import write_dataset
+from ncd.pipeline.workflow import start
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)
 inp = snakemake.input  # noqa: F821

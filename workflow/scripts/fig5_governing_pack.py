@@ -1,7 +1,7 @@
 """Figure 5: build the packings of one shard by contact dynamics (shards/packs_<k>-of-<n>.nc)."""
 from ncd.figures import governing
-from ncd.io import write_dataset
-from ncd.pipeline import Progress, start
+from ncd.io.netcdf import write_dataset
+from ncd.pipeline.workflow import Progress, start
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)
 cfg = snakemake.params.config  # noqa: F821

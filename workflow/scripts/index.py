@@ -1,8 +1,8 @@
-"""Write results/index.html, the reproduction page (ncd.report)."""
+"""Write results/index.html, the reproduction page (ncd.pages.report)."""
 from pathlib import Path
 
-from ncd.pipeline import start
-from ncd.report import write_page
+from ncd.pages.report import write_page
+from ncd.pipeline.workflow import start
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)
 out = Path(snakemake.output[0])  # noqa: F821

@@ -1,6 +1,6 @@
 """Merge the shards of one ensemble into a single netCDF file (member order)."""
-from ncd.io import merge_shards, write_dataset
-from ncd.pipeline import start
+from ncd.io.netcdf import merge_shards, write_dataset
+from ncd.pipeline.workflow import start
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)
 ds = merge_shards(snakemake.input, dim=snakemake.params.dim)  # noqa: F821

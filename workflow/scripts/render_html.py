@@ -1,6 +1,6 @@
-"""An executed notebook as a clean offline HTML page (ncd.render.render)."""
-from ncd.pipeline import start
-from ncd.render import render
+"""An executed notebook as a clean offline HTML page (ncd.pages.render.render)."""
+from ncd.pages.render import render
+from ncd.pipeline.workflow import start
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)
 log.info("%s -> %s", snakemake.params.executed,  # noqa: F821

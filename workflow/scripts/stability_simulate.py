@@ -1,7 +1,7 @@
 """Run every case of the stability table (CD at each h, MD at each factor of h_crit)."""
-from ncd.io import provenance, write_dataset
-from ncd.nlgs import SolverSettings
-from ncd.pipeline import start
+from ncd.io.netcdf import provenance, write_dataset
+from ncd.pipeline.workflow import start
+from ncd.solver.settings import SolverSettings
 from ncd.studies.stability import run_table
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)

@@ -1,7 +1,7 @@
 """Shrink a figure to a README thumbnail (at most 640 x 400 pixels)."""
 from PIL import Image
 
-from ncd.pipeline import start
+from ncd.pipeline.workflow import start
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)
 with Image.open(snakemake.input[0]) as im:  # noqa: F821

@@ -1,0 +1,236 @@
+"""A ∩ C as one sparse HiGHS model: exact ranges, polygons and angle ranges (Moreau 2005, section 4).
+
+The equilibrium forces of a packing form the polytope
+``A ∩ C = {r : H r + F = 0, |r_t| <= mu r_n}`` (:class:`ncd.exact.polytope.ForcePolytope`
+builds its scaled equations).  :class:`ExactSet` keeps one HiGHS model (``highspy``)
+whose only rows are the equilibrium equations -- the Coulomb sectors are column
+bounds (:func:`cone_columns`) -- and changes only its objective between queries, so
+that each LP restarts (primal simplex) from the previous optimal basis:
+
+* :meth:`ExactSet.interval`: exact min and max of a linear functional;
+* :meth:`ExactSet.polygon`: the exact image of A ∩ C under a 2-row map (a cut
+  resultant), support directions then every hull edge confirmed;
+* :meth:`ExactSet.angle_range`: the exact range of the direction of such an image,
+  a linear-fractional program solved by Dinkelbach's iteration (a few LPs, no polygon).
+"""
+import time
+
+import highspy
+import numpy as np
+import scipy.sparse as sp
+
+from ncd.core import validate
+from ncd.exact.polygon import outside_distance, support_polygon
+from ncd.exact.polytope import ForcePolytope, PolytopeError
+
+FEAS_TOL = 1e-10
+
+
+class ExactSet:
+    """A ∩ C of ``H r + F = 0`` (r: 2 kappa forces) with Coulomb cones, as one HiGHS model."""
+
+    def __init__(self, H, F, mu):
+        self.fp = fp = ForcePolytope(H, F, mu)
+        self.scale, self.n = fp.scale, 2 * fp.n_contacts
+        self.T, upper = cone_columns(fp.mu)
+        self._Tt = self.T.T.tocsr()
+        h = sector_model(fp.A_eq, fp.b_eq, self.T, upper,
+                         primal_feasibility_tolerance=FEAS_TOL, dual_feasibility_tolerance=FEAS_TOL,
+                         threads=1, random_seed=0, simplex_strategy=4)
+        self.highs, self.n_lp, self.lp_time = h, 0, 0.0
+        self._cols = np.arange(self.n, dtype=np.int32)
+
+    def minimize(self, c):
+        """``(min c . r, r)`` over A ∩ C (``c`` in force units, ``r`` forces)."""
+        c = validate.array("c", c, (self.n,))
+        t0 = time.perf_counter()
+        self.highs.changeColsCost(self.n, self._cols, self._Tt @ c * self.scale)
+        self.highs.run()
+        status = self.highs.getModelStatus()
+        self.n_lp += 1
+        self.lp_time += time.perf_counter() - t0
+        if status == highspy.HighsModelStatus.kInfeasible:
+            raise PolytopeError("A ∩ C is empty: no contact forces balance the weights")
+        if status != highspy.HighsModelStatus.kOptimal:
+            raise PolytopeError(f"LP not solved: {self.highs.modelStatusToString(status)}")
+        r = self.T @ np.maximum(np.asarray(self.highs.getSolution().col_value), 0.0) * self.scale
+        return float(np.dot(c, r)), r
+
+    def interval(self, c):
+        """Exact ``(min, max)`` of ``c . r`` over A ∩ C."""
+        lo = self.minimize(c)[0]
+        hi = -self.minimize(-np.asarray(c, dtype=float))[0]
+        return lo, hi
+
+    def refine(self, r, active_tol=1e-7):
+        """An LP vertex ``r`` (forces) made exact: the Coulomb rows it meets within
+        ``active_tol`` (scaled) and the equilibrium equations solved together by the
+        minimum-norm correction (iterated Tikhonov on ``[[I, K^T], [K, -eps I]]``, one
+        sparse LU), which removes the LP's feasibility-tolerance residue (HiGHS: ~1e-8
+        of the force scale)."""
+        x = np.asarray(r, float) / self.scale
+        G, A = self.fp.G, self.fp.A_eq
+        act = (G @ x) >= -active_tol
+        K = sp.vstack([A, G[np.nonzero(act)[0]]]).tocsr()
+        rhs = np.concatenate([self.fp.b_eq, np.zeros(int(act.sum()))])
+        return (x + _min_norm(K, rhs - K @ x)) * self.scale
+
+    def intervals(self, rows):
+        """Exact ``(min, max)`` of each row of a sparse matrix over A ∩ C, shape (m, 2).
+
+        All minima first, then all maxima, in row order: neighbouring rows (a
+        pressure profile) have neighbouring optima, so each LP restarts close by."""
+        rows = validate.matrix("rows", rows, (None, self.n))
+        out = np.empty((rows.shape[0], 2))
+        for j, sign in ((0, 1.0), (1, -1.0)):
+            for i in range(rows.shape[0]):
+                out[i, j] = sign * self.minimize(sign * rows[i].toarray().ravel())[0]
+        return out
+
+    def polygon(self, L, n_dirs=180, tol=1e-9, max_lp=4000):
+        """Exact image of A ∩ C under the (2, 2 kappa) map ``L``: a convex polygon.
+
+        Support points in ``n_dirs`` evenly spread directions, then each edge of
+        their hull tested along its outer normal (a point beyond it by more than
+        ``tol`` times the force scale is added) until every edge is confirmed.
+        Returns ``vertices`` (ccw), ``inner_area``, ``outer_area`` (the polygon
+        of all supporting half-planes), ``n_lp``, ``exact`` and ``points`` (the
+        support points' full force vectors, one per LP).
+        """
+        L = validate.matrix("L", L, (2, self.n))
+        n_dirs = validate.integer("n_dirs", n_dirs, 3, 10 ** 6)
+        Lt = L.T.tocsr()
+        full = []
+
+        def query(u):
+            _, r = self.minimize(-(Lt @ u))
+            full.append(r)
+            return L @ r
+
+        dirs = [np.array([np.cos(a), np.sin(a)]) for a in 2 * np.pi * np.arange(n_dirs) / n_dirs]
+        out = support_polygon(query, dirs, tol * self.scale, max_lp, self.scale)
+        out["points"] = np.array(full)
+        return out
+
+    def angle_range(self, L, outer=1.0, ref=None, tol=1e-12, max_lp=60, retry=True):
+        """Exact range of ``phi = atan2(-g_y, outer g_x)`` over ``g = L r``, r in A ∩ C
+        (degrees): the angle below the horizontal, pointing outward, of a cut resultant.
+
+        Around a reference direction ``phi0`` (``ref``; default, or NaN: an LP point), with
+        ``p = a . u``, ``q = b . u`` (``u = (outer g_x, -g_y)``, ``a`` along ``phi0``, ``b``
+        normal to it), ``tan(phi - phi0) = q / p``.  One LP certifies ``p > 0`` on all of
+        A ∩ C (the image lies in an open half-plane, so its angles span less than 180°);
+        then ``max q / p`` (and ``min``) by Dinkelbach's iteration: with ``lam = q / p``
+        at the current point, ``max (q - lam p)`` is 0 at the optimum, and otherwise its
+        maximiser has a larger ratio.  The final LP value ``v`` bounds the error of the
+        ratio by ``v / p_min`` (``bound``, radians, reported).  Returns a dict: ``lo``, ``hi``
+        (degrees), ``bound`` (the larger of the two certificates, degrees), ``p_min``
+        (N), ``n_lp``, ``points`` (forces at the two extremes); ``lo = hi = nan`` and
+        ``p_min <= 0`` when the image contains the origin.  If ``ref`` does not separate the
+        image from the origin, the exact polygon (:meth:`polygon`) gives a direction that
+        does, and the range is computed again around it (``retry``).
+        """
+        L = validate.matrix("L", L, (2, self.n))
+        M = sp.diags([float(outer), -1.0]) @ L          # r -> u = (outer g_x, -g_y)
+        Mt = M.T.tocsr()
+        n0 = self.n_lp
+        if ref is None or not np.isfinite(ref):
+            u = M @ self.minimize(np.zeros(L.shape[1]))[1]
+            ref = np.degrees(np.arctan2(u[1], u[0]))
+        t = np.radians(ref)
+        a, b = np.array([np.cos(t), np.sin(t)]), np.array([-np.sin(t), np.cos(t)])
+        p_min, r = self.minimize(Mt @ a)
+        out = {"p_min": p_min, "lo": np.nan, "hi": np.nan, "bound": np.nan, "points": np.zeros((2, L.shape[1]))}
+        if not p_min > 1e-9 * self.scale:
+            # the reference direction does not separate the image from the origin: the
+            # exact polygon decides (its angle range, or NaN if it contains the origin)
+            poly = self.polygon(L, n_dirs=12)
+            v = (M @ np.asarray(poly["points"]).T).T
+            if len(poly["vertices"]) < 3 or outside_distance(np.zeros((1, 2)), poly["vertices"])[0] > 0.0:
+                phi = np.degrees(np.arctan2(v[:, 1], v[:, 0]))
+                d = (phi - ref + 180.0) % 360.0 - 180.0
+                mid = ref + 0.5 * (d.min() + d.max())
+                if d.max() - d.min() < 180.0 and retry:
+                    out = self.angle_range(L, outer, ref=mid, tol=tol, max_lp=max_lp, retry=False)
+                    out["n_lp"] = self.n_lp - n0
+                    return out
+            out["n_lp"] = self.n_lp - n0
+            return out
+        ends, bounds = [], []
+        for j, sign in enumerate((-1.0, 1.0)):          # min, then max of q / p
+            u = M @ r
+            lam = sign * (b @ u) / (a @ u)
+            for _ in range(max_lp):
+                v, r_new = self.minimize(-(Mt @ (sign * b - lam * a)))
+                v = -v                                   # max of sign q - lam p
+                u_new = M @ r_new
+                lam_new = sign * (b @ u_new) / (a @ u_new)
+                if v <= tol * self.scale or lam_new <= lam:
+                    break
+                lam, r = lam_new, r_new
+            ends.append(ref + sign * np.degrees(np.arctan(lam)))
+            bounds.append(max(v, 0.0) / p_min)
+            out["points"][j] = r
+        out.update(lo=float(ends[0]), hi=float(ends[1]), bound=float(np.degrees(max(bounds))),
+                   n_lp=self.n_lp - n0)
+        return out
+
+
+def sector_model(A_eq, b_eq, T, upper, **options):
+    """A HiGHS model of ``A_eq T y = b_eq``, ``0 <= y <= upper`` (the Coulomb sectors as
+    column bounds, :func:`cone_columns`), zero cost, silent, with the given options."""
+    A = (A_eq @ T).tocsc()
+    n = A.shape[1]
+    lp = highspy.HighsLp()
+    lp.num_col_, lp.num_row_ = n, A.shape[0]
+    lp.col_cost_ = np.zeros(n)
+    lp.col_lower_ = np.zeros(n)
+    lp.col_upper_ = upper
+    lp.row_lower_ = b_eq
+    lp.row_upper_ = b_eq
+    lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
+    lp.a_matrix_.start_ = A.indptr
+    lp.a_matrix_.index_ = A.indices
+    lp.a_matrix_.value_ = A.data
+    h = highspy.Highs()
+    h.silent()
+    for k, v in options.items():
+        h.setOptionValue(k, v)
+    h.passModel(lp)
+    return h
+
+
+def cone_columns(mu):
+    """The Coulomb sectors as bounds: ``r = T y`` with ``y >= 0`` (``y <= upper``).
+
+    Per contact ``y = (a, b) = (mu r_n + r_t, mu r_n - r_t)``, so that ``|r_t| <= mu r_n``
+    is ``a, b >= 0`` (``r_n = (a + b) / (2 mu)``, ``r_t = (a - b) / 2``); a frictionless
+    contact has ``r_n = a``, ``r_t = 0`` (``b`` fixed at 0).  The LP then has only the
+    equilibrium rows, and every LP point satisfies Coulomb's law to round-off."""
+    mu = np.asarray(mu, dtype=float)
+    k = len(mu)
+    i = np.arange(k)
+    rough = mu > 0
+    inv = np.where(rough, 0.5 / np.where(rough, mu, 1.0), 1.0)
+    rows = np.concatenate([2 * i, 2 * i, 2 * i + 1, 2 * i + 1])
+    cols = np.concatenate([2 * i, 2 * i + 1, 2 * i, 2 * i + 1])
+    vals = np.concatenate([inv, np.where(rough, inv, 0.0), np.where(rough, 0.5, 0.0), np.where(rough, -0.5, 0.0)])
+    T = sp.csr_matrix((vals, (rows, cols)), shape=(2 * k, 2 * k))
+    T.eliminate_zeros()
+    upper = np.full(2 * k, highspy.kHighsInf)
+    upper[2 * i[~rough] + 1] = 0.0
+    return T, upper
+
+
+def _min_norm(K, r, eps=1e-12, refine=20):
+    """Minimum-norm ``d`` with ``K d = r`` (K: p x n sparse, consistent)."""
+    from scipy.sparse.linalg import splu
+    p, n = K.shape
+    lu = splu(sp.bmat([[sp.identity(n), K.T], [K, -eps * sp.identity(p)]], format="csc"))
+    d = np.zeros(n)
+    for _ in range(refine):
+        e = r - K @ d
+        if np.abs(e).max(initial=0.0) <= 1e-16 * max(np.abs(r).max(initial=0.0), 1e-300):
+            break
+        d += lu.solve(np.concatenate([np.zeros(n), e]))[:n]
+    return d

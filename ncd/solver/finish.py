@@ -1,0 +1,318 @@
+"""Finishing stage: the exact solution NLGS converges towards (issue 13, item 2).
+
+NLGS settles the *status* of every contact (open, stick, slide forward or
+backward) long before its impulses converge, and on a dense or indeterminate
+problem (a pile at rest, a wedged grain) its last decades of residual take
+most of the sweeps, or never come.  With the statuses fixed the one-step
+solutions form a polyhedron (2-D Coulomb cones are polyhedral,
+:mod:`ncd.solver.finish_lp`), so the finishing stage (:func:`polish`):
+
+1. lets NLGS go on while its own rate predicts ``finish_tol`` soon
+   (within :data:`LP_SWEEPS` sweeps);
+2. otherwise projects the iterate ``s_k`` on the polyhedron of its statuses: the
+   point ``s`` nearest to ``s_k`` in the L1 norm (an LP, HiGHS), a small
+   correction that stays on the solution NLGS is approaching (no jump to another
+   one of an indeterminate problem);  an elastic LP naming the contacts whose status
+   is wrong (``ncd.solver.finish_lp.project(elastic=...)``) was tried on the pile: it never made
+   the polyhedron non-empty and cost twice a projection, so it is not used; nor is a
+   mixed-integer projection (HiGHS branch and bound choosing the statuses of the least
+   settled contacts, big-M Signorini-Coulomb rows): on the pile, order 1 of the bench, it
+   was infeasible with 40 free contacts and found no incumbent in 60 s with 200;
+3. accepts the projection when its relative natural-map residual is ``<= finish_tol``
+   and it moves the impulses by at most :data:`MAX_CORRECTION` (relative L1);
+   otherwise NLGS goes on (chunks growing 4x, within the sweep budget) and 2 is tried
+   again (:data:`MAX_ATTEMPTS` times at most).  When the budget runs out the best
+   iterate seen is returned, unconverged.
+
+When the iterate's statuses give an empty polyhedron and the residual is below
+:data:`REST_GATE`, the polyhedron of :func:`rest_status` (every contact sticking: the
+states at rest, A ∩ C times ``h``) is tried the same way.
+
+Measured on the 1000-grain pile's final state (Figure 4, 1721 contacts) from the zero
+guess, 32 random review orders, handing over at 1e-5: every run reaches a residual
+<= 1e-10 (largest 6e-11) in 2.6-6.9 s.  NLGS drifts near 1e-6 (its impulses change by
+a constant ~5e-10 per sweep), the polyhedron of its statuses is empty, and the nearest
+state at rest is 2.2-2.6 % away (L1): 28 runs end at rest (grains below 3e-11 g h).
+Four end on a motion solution (a grain wedged between two neighbours falls free, speed
+g h, and 19 grains at the apex move at 0.01-0.7 g h): two reached by NLGS alone, two by
+the status projection (0.7 % away).  HiGHS's crossover is
+capped (:data:`ncd.solver.finish_lp.SIMPLEX_LIMIT`): uncapped, one empty polyhedron kept it
+20 s without an answer.  Where NLGS converges at a steady rate (fig2's step, dense
+packings) the stage is NLGS itself, with chunks that run to their end: on fig2's step
+19,720 sweeps to 1e-10 against plain NLGS's 8,720.  Stopping a chunk at the first check
+below ``finish_tol`` was tried and dropped: stopped at 1e-10, the grains of the
+convergence test's column moved at 8e-9 g h (where that test bounds a finished state by
+1e-9) and no run of the reduced pile passed the rest bound (1e-8 g h); the run to the
+chunk's end takes the residual far below the target (~1e-14).
+
+:func:`check_solution` checks a solution componentwise (cone, complementarity,
+sticking and sliding velocities).  :func:`project_statuses` (the minimum-norm point
+of the affine set of a status pattern, sparse LU) serves the census of
+:mod:`ncd.figures.census`, which enumerates status patterns.
+"""
+import logging
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ncd.core.contacts import h_matrix
+from ncd.solver.finish_lp import StatusLP, project
+from ncd.solver.kernels import iterate_discs, iterate_local, problem_scale
+from ncd.solver.single_contact import NO_CONTACT, SLIDE_BACKWARD, SLIDE_FORWARD, STICK
+
+FIRST_CHUNK = 50         # NLGS sweeps (at least; a quarter of those made) that measure NLGS's rate
+LP_SWEEPS = 50000        # NLGS goes on while its rate predicts finish_tol within this many sweeps
+MAX_ATTEMPTS = 3         # failed projections (an empty polyhedron costs 10-20 s on the pile) before NLGS alone
+REST_GATE = 1e-5         # the rest polyhedron is tried from iterates this close only (far ones: long LPs, rejected)
+MAX_CORRECTION = 0.05    # a projection moving the impulses by more (relative L1) is a jump: rejected
+LOG = logging.getLogger(__name__)
+REFINE = 30              # iterated-Tikhonov refinements of one minimum-norm correction (census)
+
+
+def global_delassus(scene, contacts):
+    """``(W, H, M^-1)``: the sparse Delassus matrix ``W = H^T M^-1 H`` (2n, 2n)."""
+    H = h_matrix(scene, contacts).tocsr()
+    nm = scene.n_mobile
+    minv = np.column_stack([scene.inv_mass[:nm], scene.inv_mass[:nm], scene.inv_inertia[:nm]]).ravel()
+    return (H.T @ sp.diags(minv) @ H).tocsr(), H, minv
+
+
+def natural_map(s, U, mu, rho):
+    """Per-contact natural map ``s - proj_K(s - rho U~)`` (n, 2), vectorized
+    (:func:`ncd.solver.single_contact.natural_map_sq`), and the regions of ``z``."""
+    zn = s[:, 0] - rho * (U[:, 0] + mu * np.abs(U[:, 1]))
+    zt = s[:, 1] - rho * U[:, 1]
+    inside = (zn >= 0) & (np.abs(zt) <= mu * zn)
+    polar = ~inside & (mu * np.abs(zt) <= -zn)
+    pn = np.where(inside, zn, np.where(polar, 0.0, (zn + mu * np.abs(zt)) / (1 + mu * mu)))
+    pt = np.where(inside, zt, np.where(polar, 0.0, np.sign(zt) * mu * pn))
+    status = np.where(inside, STICK, np.where(polar, NO_CONTACT,
+                                              np.where(zt > 0, SLIDE_BACKWARD, SLIDE_FORWARD)))
+    return np.column_stack([s[:, 0] - pn, s[:, 1] - pt]), status.astype(np.int8)
+
+
+def relative_residual(s, U, mu, rho, scale):
+    """The relative natural-map residual of :mod:`ncd.solver.nlgs`."""
+    F, _ = natural_map(s, U, mu, rho)
+    return float(np.sqrt(np.sum(F ** 2)) / max(scale, np.sqrt(np.sum(s ** 2)), 1e-300))
+
+
+def status_system(mu, status):
+    """``(P, S)``: impulses ``s = P x`` and constrained velocity rows ``S^T U`` of the statuses."""
+    n = len(status)
+    stick = (status == STICK) | (status > SLIDE_BACKWARD)       # FALLBACK reads as stick
+    slide = (status == SLIDE_FORWARD) | (status == SLIDE_BACKWARD)
+    sign = np.where(status == SLIDE_FORWARD, -1.0, 1.0)
+    prow, pcol, pval, srow = [], [], [], []
+    col = 0
+    for c in range(n):
+        if stick[c]:
+            prow += [2 * c, 2 * c + 1]
+            pcol += [col, col + 1]
+            pval += [1.0, 1.0]
+            srow += [2 * c, 2 * c + 1]
+            col += 2
+        elif slide[c]:
+            prow += [2 * c, 2 * c + 1]
+            pcol += [col, col]
+            pval += [1.0, sign[c] * mu[c]]
+            srow.append(2 * c)
+            col += 1
+    P = sp.csr_matrix((pval, (prow, pcol)), shape=(2 * n, col))
+    S = sp.csr_matrix((np.ones(col), (srow, np.arange(col))), shape=(2 * n, col))
+    return P, S
+
+
+def min_norm_solve(K, r, eps_rel=1e-10):
+    """Minimum-norm solution of the consistent system ``K d = r`` (iterated Tikhonov on
+    ``[[I, K^T], [K, -eps I]]``, one sparse LU, refined while each step at least halves
+    the residual); a truncated least-squares one otherwise."""
+    m = K.shape[0]
+    if m == 0:
+        return np.zeros(0)
+    eps = eps_rel * max(abs(K).sum(axis=1).max(), 1e-300) ** 2
+    A = sp.bmat([[sp.identity(m), K.T], [K, -eps * sp.identity(m)]], format="csc")
+    lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                  options={"SymmetricMode": True})
+    d = np.zeros(m)
+    rnorm, prev = np.linalg.norm(r), np.inf
+    for _ in range(REFINE):
+        e = r - K @ d
+        enorm = np.linalg.norm(e)
+        # stop at round-off, or when a refinement no longer halves the residual (the
+        # rest lies along nearly singular modes: a truncated minimum-norm correction)
+        if enorm <= 1e-15 * max(rnorm, 1e-300) or enorm > 0.5 * prev:
+            break
+        prev = enorm
+        d += lu.solve(np.concatenate([np.zeros(m), e]))[:m]
+    return d
+
+
+def project_statuses(W, q, mu, s0, status):
+    """The point of the affine set of ``status`` nearest to ``s0`` (in the unknowns ``x``)."""
+    P, S = status_system(mu, status)
+    K = (S.T @ W @ P).tocsr()
+    x0 = (P.T @ s0.ravel()) / np.asarray(P.multiply(P).sum(axis=0)).ravel()   # x0 = P^+ s0
+    r = -(S.T @ (W @ (P @ x0) + q))
+    return (P @ (x0 + min_norm_solve(K, r))).reshape(-1, 2)
+
+
+def polish(lp, W, q, mu, rho, scale, s0, status0, tol, more_sweeps, max_sweeps, sweeps0):
+    """Finishing stage from the NLGS iterate ``s0`` (statuses ``status0``, after ``sweeps0`` sweeps).
+
+    NLGS goes on (``more_sweeps(k) -> (s, status)``; a first chunk measures its rate)
+    while its rate predicts ``tol`` within :data:`LP_SWEEPS` sweeps.  Otherwise the
+    iterate is projected on the polyhedron of its statuses (:func:`ncd.solver.finish_lp.project`).
+    A projection is accepted when its natural-map residual is
+    ``<= tol`` and it moves the impulses by at most :data:`MAX_CORRECTION` (relative L1;
+    a larger move reaches another solution).  Else NLGS goes on (chunks growing 4x) and
+    the projection is tried again, :data:`MAX_ATTEMPTS` times at most.  Returns ``(s,
+    status, residual, lp_solves, ok, extra_sweeps, correction)``: the best iterate when
+    the sweep budget runs out; ``correction`` is ``|s - s_k|_1 / |s_k|_1`` of the
+    accepted projection (0 when NLGS got there)."""
+    def residual(s):
+        return relative_residual(s, (W @ s.ravel() + q).reshape(-1, 2), mu, rho, scale)
+
+    s, status = s0, np.where(status0 > SLIDE_BACKWARD, STICK, status0).astype(np.int8)
+    res = residual(s)
+    best = (res, s, status)
+    solves, attempts, extra, chunk, rate = 0, 0, 0, max(FIRST_CHUNK, sweeps0 // 4, 1), None
+    while True:
+        if res <= tol:
+            return s, status, res, solves, True, extra, 0.0
+        ahead = np.inf if rate is None or rate <= 0 else np.log(res / tol) / rate
+        if rate is None and FIRST_CHUNK > 0:
+            k = min(chunk, max_sweeps - extra)                                # NLGS's rate first
+        elif ahead <= LP_SWEEPS:
+            k = int(min(np.ceil(1.2 * ahead) + 10, max_sweeps - extra))     # NLGS converges: let it
+        elif attempts >= MAX_ATTEMPTS:
+            k = min(chunk, max_sweeps - extra)
+            chunk *= 4
+        else:
+            attempts += 1
+            solves += 1
+            cand, _, info = project(lp, s, status)
+            if cand is None and res <= REST_GATE:   # no solution with the iterate's statuses: the nearest at rest
+                cand, _, info = project(lp, s, rest_status(lp))
+                LOG.debug("rest polyhedron: %s", info["status"])
+            r = np.inf if cand is None else residual(cand)
+            LOG.debug("sweeps %d residual %.2e: LP (%s, %d iterations) -> %.2e",
+                      sweeps0 + extra, res, info["status"], info["iterations"], r)
+            if cand is not None:
+                region = natural_map(cand, (W @ cand.ravel() + q).reshape(-1, 2), mu, rho)[1]
+                corr = info["correction"] / max(np.abs(s).sum(), 1e-300)
+                if r < best[0] and info["correction"] <= MAX_CORRECTION * np.abs(s).sum():
+                    best = (r, cand, region)
+                if r <= tol and corr <= MAX_CORRECTION:
+                    return cand, region, r, solves, True, extra, corr
+                # else: an empty polyhedron, a residual above tol, or a jump to another
+                # solution far from the iterate: more sweeps first
+            k = min(chunk, max_sweeps - extra)
+            chunk *= 4
+        if k <= 0:
+            return best[1], best[2], best[0], solves, False, extra, float("nan")
+        s_new, status = more_sweeps(k)
+        status = np.where(status > SLIDE_BACKWARD, STICK, status).astype(np.int8)
+        extra += k
+        res_new = residual(s_new)
+        rate = np.log(res / res_new) / k if res_new > 0 else np.inf
+        s, res = s_new, res_new
+        if res < best[0]:
+            best = (res, s, status)
+
+
+def rest_status(lp):
+    """Every contact sticking (``U = 0``) except those whose gap velocity is positive with
+    the bodies at rest (``b_n > 0``: open).  Its polyhedron is the set of one-step
+    solutions at rest: the equilibrium forces A ∩ C (times ``h``) where the free motion
+    is the weight's."""
+    return np.where(lp.b[0::2] > 0, NO_CONTACT, STICK).astype(np.int8)
+
+
+def check_solution(impulse, U, mu, tol=1e-8, velocity_scale=None):
+    """Componentwise check of the Signorini-Coulomb law; returns a dict of the largest
+    violations (impulses over ``max |s|``, velocities over ``velocity_scale``, default
+    ``max |U|``; pass the free-velocity scale, e.g. ``|g| h``, at rest) and ``ok``.
+
+    cone: ``s_n >= 0``, ``|s_t| <= mu s_n``; normal complementarity ``U_n >= 0``,
+    ``s_n U_n = 0``; sticking contacts (``|s_t| < mu s_n``): ``U_t = 0``; sliding
+    ones: ``U_t`` opposite to ``s_t`` (``s_t U_t <= 0``)."""
+    s = np.asarray(impulse, float).reshape(-1, 2)
+    U = np.asarray(U, float).reshape(-1, 2)
+    S = max(float(np.abs(s).max(initial=0.0)), 1e-300)
+    V = float(np.abs(U).max(initial=0.0)) if velocity_scale is None else float(velocity_scale)
+    V = V if V > 0 else 1.0
+    sn, st = s[:, 0] / S, s[:, 1] / S
+    un, ut = U[:, 0] / V, U[:, 1] / V
+    inner = np.abs(st) < mu * sn - tol
+    out = {
+        "cone_normal": float(max(0.0, -sn.min(initial=0.0))),
+        "cone_tangential": float(max(0.0, (np.abs(st) - mu * sn).max(initial=0.0))),
+        "gap_velocity": float(max(0.0, -un.min(initial=0.0))),
+        "complementarity": float(np.abs(sn * un).max(initial=0.0)),
+        "sticking_velocity": float(np.abs(ut[inner]).max(initial=0.0)),
+        "sliding_direction": float(max(0.0, (st * ut)[~inner].max(initial=0.0))),
+    }
+    out["ok"] = all(v <= tol for v in out.values())
+    return out
+
+
+def polish_local(Wc, q, mu, Wd, data, order, result, settings):
+    """The finishing stage of :func:`ncd.solver.nlgs.solve_local` (``data`` its kernel data)."""
+    n = len(mu)
+    scale = problem_scale(q.reshape(n, 2), Wd)
+    flat, status = data[6], result.status
+
+    def more(k):
+        keep = (np.array([-np.inf, 0.0, 0.0]), np.empty_like(flat), np.empty_like(status), np.empty(0), 0)
+        iterate_local(data, order, status, scale, 0.0, k, 0, k, keep)
+        return flat.reshape(n, 2).copy(), status.copy()
+
+    s0 = flat.reshape(n, 2).copy()
+    lp = StatusLP.local(Wc, q, mu, max(float(np.abs(s0).max(initial=0.0)), scale / np.sqrt(n)),
+                        max(float(np.abs(q).max()), 1e-300))
+    out = polish(lp, Wc, q, mu, 1.0 / Wd[:, 0, 0], scale, s0, status.copy(), settings.finish_tol, more,
+                 settings.max_sweeps, result.sweeps)
+    flat[:] = out[0].ravel()
+    return _finished(result, *out)
+
+
+def polish_discs(scene, contacts, vel, spin, bias, q_free, Wb, flat, order, result, settings):
+    """The finishing stage of :func:`ncd.solver.nlgs.solve_discs`; updates the body velocities."""
+    n = contacts.n
+    W, H, minv = global_delassus(scene, contacts)
+    scale = problem_scale(q_free, Wb)
+    body, imp, status = flat[2].reshape(-1, 4), flat[3], result.status
+    s_start = imp.reshape(n, 2).copy()
+
+    def more(k):
+        keep = (np.array([-np.inf, 0.0, 0.0]), np.empty_like(imp), np.empty_like(status), np.empty_like(flat[2]), 0)
+        iterate_discs(flat, order, status, scale, 0.0, k, 0, k, keep)
+        return imp.reshape(n, 2).copy(), status.copy()
+
+    # q of U = W s + q: the free local velocity (bias included) of :func:`solve_discs`
+    nm = scene.n_mobile
+    free = np.column_stack([vel[:nm], spin[:nm]]).ravel()       # u_free (vel, spin untouched so far)
+    lp = StatusLP.discs(H, minv, free, bias, contacts.mu, scene.radius[:nm],
+                        max(float(np.abs(s_start).max(initial=0.0)), scale / np.sqrt(n)),
+                        max(float(np.abs(q_free).max()), 1e-300))
+    out = polish(lp, W, q_free.ravel(), contacts.mu, 1.0 / Wb[:, 0, 0], scale, s_start, status.copy(),
+                 settings.finish_tol, more, settings.max_sweeps, result.sweeps)
+    s = out[0]
+    if not np.array_equal(s, imp.reshape(n, 2)):       # a projection: u_f = u_free + M^-1 H s
+        body[:nm, :3] = (free + minv * (H @ s.ravel())).reshape(nm, 3)
+        imp[:] = s.ravel()
+    return _finished(result, *out)
+
+
+def _finished(result, s, status, res, solves, ok, extra, correction):
+    result.impulse = s
+    result.status = status
+    result.residual = res
+    result.converged = bool(ok)
+    result.finish_rounds = solves
+    result.finish_correction = correction
+    result.sweeps += extra
+    result.observable_change = float("nan")   # an exact solution: nothing left to settle
+    return result

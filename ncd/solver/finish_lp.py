@@ -1,0 +1,159 @@
+"""The status polyhedron of a Contact Dynamics step, and the nearest point of it (LP, HiGHS).
+
+In 2-D the Coulomb cone is polyhedral, so once every contact's status is fixed the
+one-step solutions with those statuses form a polyhedron (Moreau 2005, section 2;
+``U = H^T u + b``, ``M (u - u_free) = H s``):
+
+* open: ``s = 0``, ``U_n >= 0``;
+* stick: ``U_n = U_t = 0``, ``|s_t| <= mu s_n``;
+* slide forward: ``U_n = 0``, ``s_t = -mu s_n``, ``U_t >= 0``;
+* slide backward: ``U_n = 0``, ``s_t = +mu s_n``, ``U_t <= 0``;
+
+and ``s_n >= 0`` everywhere.  :func:`project` returns its point nearest to an
+iterate ``s0`` in the L1 norm, ``min sum |s - s0|`` (a linear program, solved by
+HiGHS: interior point then crossover to a vertex, one thread: deterministic), or reports it empty.  The body
+velocities are kept as unknowns in the disc form, so the LP stays as sparse as ``H``;
+a problem in local form (``U = W s + q``) uses ``W``.  Unknowns and rows are scaled
+to order one (impulses by ``S``, velocities by ``V``, spins by ``V / r``), and the
+primal feasibility tolerance is :data:`FEASIBILITY` of those scales, so the vertex
+HiGHS returns satisfies the statuses' equalities to round-off.
+"""
+import highspy
+import numpy as np
+import scipy.sparse as sp
+
+from ncd.solver.single_contact import NO_CONTACT, SLIDE_BACKWARD, SLIDE_FORWARD, STICK
+
+FEASIBILITY = 1e-9       # HiGHS primal feasibility tolerance, of the scaled rows
+# Crossover iterations at most: on the pile's final state (review order 0 of the bench) the
+# polyhedron of the NLGS statuses is empty, the interior-point stage does not say so, and
+# crossover ran 13,000 iterations (20 s) without an answer; the projections that succeed
+# take 0-25.  A count, not a time limit: the outcome does not depend on the machine's load.
+SIMPLEX_LIMIT = 2000
+OPTIONS = {"threads": 1, "solver": "ipm", "run_crossover": "on", "primal_feasibility_tolerance": FEASIBILITY,
+           "dual_feasibility_tolerance": 1e-9, "simplex_iteration_limit": SIMPLEX_LIMIT}
+INF = highspy.kHighsInf
+
+
+class StatusLP:
+    """The linear pieces of one step: ``U = B x + b`` for unknowns ``x = (y, s)``,
+    ``A x = a`` (the dynamics), ``y`` of scale ``y_scale`` (none in local form)."""
+
+    def __init__(self, B, b, A, a, y_scale, mu, S, V):
+        self.B, self.b, self.A, self.a = sp.csr_matrix(B), np.asarray(b, float).ravel(), sp.csr_matrix(A), a
+        self.y_scale, self.mu, self.S, self.V = np.asarray(y_scale, float), np.asarray(mu, float), S, V
+        self.ny, self.n = len(self.y_scale), len(self.mu)
+
+    @classmethod
+    def discs(cls, H, minv, free, bias, mu, radius, S, V):
+        """Disc form: ``y = u`` (3 per mobile disc), ``B = [H^T, 0]``, ``u - M^-1 H s = u_free``."""
+        nb = H.shape[0]
+        B = sp.hstack([H.T, sp.csr_matrix((H.shape[1], H.shape[1]))])
+        A = sp.hstack([sp.identity(nb), -(sp.diags(minv) @ H)])
+        y_scale = np.column_stack([np.full(len(radius), V), np.full(len(radius), V), V / radius]).ravel()
+        return cls(B, bias, A, free, y_scale, mu, S, V)
+
+    @classmethod
+    def local(cls, W, q, mu, S, V):
+        """Local form: ``U = W s + q``, no other unknown."""
+        return cls(W, q, sp.csr_matrix((0, W.shape[1])), np.zeros(0), np.zeros(0), mu, S, V)
+
+
+def _cone_rows(idx, mu, sign, n):
+    """Rows ``mu s_n + sign s_t`` of contacts ``idx`` (on the 2n impulses)."""
+    m = len(idx)
+    cols = np.column_stack([2 * idx, 2 * idx + 1]).ravel()
+    vals = np.column_stack([mu[idx], np.full(m, sign)]).ravel()
+    return sp.csr_matrix((vals, (np.repeat(np.arange(m), 2), cols)), shape=(m, 2 * n))
+
+
+def project(lp, s0, status, elastic=0.0):
+    """Point of the polyhedron of ``status`` nearest to ``s0`` (n, 2) in the L1 norm.
+
+    Returns ``(s, y, info)``; ``s`` is None when the polyhedron is empty (or HiGHS
+    stops otherwise: ``info["status"]`` says why).  ``info``: LP size, simplex
+    iterations, ``correction`` = ``sum |s - s0|``.  With ``elastic > 0`` the velocity
+    conditions of the statuses may be violated at that cost per unit of ``V`` (an exact
+    penalty: always feasible); ``info["slack"]`` (n,) is each contact's violation / ``V``
+    (all 0: the point is the projection), which tells the statuses to change."""
+    n, ny = lp.n, lp.ny
+    st = np.where(status > SLIDE_BACKWARD, STICK, status)
+    closed = st != NO_CONTACT
+    cs = np.concatenate([lp.y_scale, np.full(2 * n, lp.S)])      # column scales
+    B = (lp.B @ sp.diags(cs)) / lp.V
+    b = lp.b / lp.V
+    Bn, Bt = B[0::2], B[1::2]
+    bn, bt = b[0::2], b[1::2]
+    # velocity rows: U_n >= 0 (open) or = 0 (closed); U_t = 0 (stick), >= 0 (forward), <= 0 (backward)
+    lo_n, hi_n = -bn, np.where(closed, -bn, INF)
+    lo_t = np.where((st == STICK) | (st == SLIDE_FORWARD), -bt, -INF)[closed]
+    hi_t = np.where((st == STICK) | (st == SLIDE_BACKWARD), -bt, INF)[closed]
+    # cone rows: mu s_n - s_t >= 0 (= 0 backward), mu s_n + s_t >= 0 (= 0 forward)
+    ia = np.nonzero((st == STICK) | (st == SLIDE_BACKWARD))[0]
+    ib = np.nonzero((st == STICK) | (st == SLIDE_FORWARD))[0]
+    def zero(m):
+        return sp.csr_matrix((m, ny))
+    rows = [Bn, Bt[closed], sp.hstack([zero(len(ia)), _cone_rows(ia, lp.mu, -1.0, n)]),
+            sp.hstack([zero(len(ib)), _cone_rows(ib, lp.mu, 1.0, n)])]
+    lo = [lo_n, lo_t, np.zeros(len(ia)), np.zeros(len(ib))]
+    hi = [hi_n, hi_t, np.where(st[ia] == SLIDE_BACKWARD, 0.0, INF), np.where(st[ib] == SLIDE_FORWARD, 0.0, INF)]
+    if ny:
+        A = (sp.diags(1.0 / lp.y_scale) @ lp.A @ sp.diags(cs))
+        rows.insert(0, A)
+        lo.insert(0, lp.a / lp.y_scale)
+        hi.insert(0, lp.a / lp.y_scale)
+    # L1 distance: s - d+ + d- = s0, d+, d- >= 0
+    m = 2 * n
+    E = sp.hstack([sp.csr_matrix((m, ny)), sp.identity(m), -sp.identity(m), sp.identity(m)])
+    x0 = np.asarray(s0, float).ravel() / lp.S
+    M = sp.vstack([sp.hstack([sp.vstack(rows), sp.csr_matrix((sum(r.shape[0] for r in rows), 2 * m))]), E]).tocsc()
+    row_lo, row_hi = np.concatenate(lo + [x0]), np.concatenate(hi + [x0])
+    owner = np.concatenate([np.arange(n), np.nonzero(closed)[0]])    # contact of each velocity row
+    if elastic > 0:        # slack columns e+ - e- on the velocity rows (after the dynamics rows)
+        k = len(owner)
+        r = ny + np.arange(k)
+        Es = sp.csc_matrix((np.concatenate([np.ones(k), -np.ones(k)]), (np.concatenate([r, r]), np.arange(2 * k))),
+                           shape=(M.shape[0], 2 * k))
+        M = sp.hstack([M, Es]).tocsc()
+    s_lo, s_hi = np.full(m, -INF), np.full(m, INF)
+    s_lo[0::2] = 0.0
+    for arr in (s_lo, s_hi):
+        arr[0::2][~closed] = 0.0
+        arr[1::2][~closed] = 0.0
+    col_lo = np.concatenate([np.full(ny, -INF), s_lo, np.zeros(2 * m)])
+    col_hi = np.concatenate([np.full(ny, INF), s_hi, np.full(2 * m, INF)])
+    cost = np.concatenate([np.zeros(ny + m), np.ones(2 * m)])
+    if elastic > 0:
+        col_lo = np.concatenate([col_lo, np.zeros(2 * k)])
+        col_hi = np.concatenate([col_hi, np.full(2 * k, INF)])
+        cost = np.concatenate([cost, np.full(2 * k, float(elastic))])
+    x, info = _solve(M, row_lo, row_hi, col_lo, col_hi, cost)
+    if x is None:
+        return None, None, info
+    s = x[ny:ny + m].reshape(n, 2) * lp.S
+    info["correction"] = float(np.abs(s - np.asarray(s0).reshape(n, 2)).sum())
+    if elastic > 0:
+        e = x[ny + 3 * m:]
+        info["slack"] = np.bincount(owner, weights=e[:k] + e[k:], minlength=n)
+    return s, x[:ny] * lp.y_scale, info
+
+
+def _solve(M, row_lo, row_hi, col_lo, col_hi, cost):
+    h = highspy.Highs()
+    h.silent()
+    for k, v in OPTIONS.items():
+        h.setOptionValue(k, v)
+    lp = highspy.HighsLp()
+    lp.num_col_, lp.num_row_ = M.shape[1], M.shape[0]
+    lp.col_cost_, lp.col_lower_, lp.col_upper_ = cost, col_lo, col_hi
+    lp.row_lower_, lp.row_upper_ = row_lo, row_hi
+    lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
+    lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = M.indptr, M.indices, M.data
+    h.passModel(lp)
+    h.run()
+    ms = h.getModelStatus()
+    info = {"status": h.modelStatusToString(ms), "rows": M.shape[0], "cols": M.shape[1],
+            "iterations": int(h.getInfo().simplex_iteration_count)}
+    if ms != highspy.HighsModelStatus.kOptimal:
+        return None, info
+    return np.array(h.getSolution().col_value), info

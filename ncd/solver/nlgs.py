@@ -1,0 +1,198 @@
+"""Nonlinear Gauss-Seidel (NLGS) for the core problem of a Contact Dynamics step.
+
+Contacts are reviewed one at a time in a given ``review_order``; each is
+solved exactly (:func:`ncd.solver.single_contact.solve_single_contact`) with the other
+impulses frozen, and the result is propagated at once (Moreau 2005, section 2).
+Two forms of the same problem share the iteration driver:
+
+* disc form: body velocities ``u`` are updated incrementally,
+  ``u += M^-1 H_alpha (s_new - s_old)``, so a sweep costs O(contacts);
+* local form: ``U = W s + q`` with a Delassus matrix ``W`` given dense or
+  sparse, as NSCD codes (LMGC90, Siconos) export 2-D frictional problems.
+
+Each run reports its sweeps, the relative impulse change of the last sweep,
+the relative natural-map residual (:func:`ncd.solver.single_contact.natural_map_sq`,
+``rho_alpha = 1 / W_alpha,nn``, divided by the largest of ``|s|`` and
+``|rho q_free|``) and a converged flag.  The stopping criterion is either the
+residual (default) or the change; non-convergence at ``max_sweeps`` is flagged,
+and the iterate returned is then the one of smallest residual seen (``keep_best``).
+With ``finish="active_set"`` the NLGS iterate is finished to ``finish_tol`` by
+:mod:`ncd.solver.finish` (projection on the polyhedron of its contact statuses, an LP); with an ``observe`` callable the run is made in chunks of
+``check_every`` sweeps and stops only when the observable has settled too
+(:mod:`ncd.solver.convergence`).
+"""
+
+import numpy as np
+import scipy.sparse as sp
+
+from ncd.core import validate
+from ncd.core.contacts import check_contacts, check_disc_blocks, delassus_blocks, local_velocity
+from ncd.core.errors import InputError
+from ncd.core.jit import njit
+from ncd.core.model import check_scene
+from ncd.core.validate import array, impulse_guess, per_item, permutation, shape_of, show, sparse_matrix
+from ncd.solver.anderson import driver
+from ncd.solver.convergence import run_nlgs
+from ncd.solver.finish import polish_discs, polish_local
+from ncd.solver.kernels import iterate_discs, iterate_local, problem_scale
+from ncd.solver.local_exact import LocalExact
+from ncd.solver.pack import apply_all, pack_problem
+from ncd.solver.settings import NLGSResult, SolverSettings, check_settings_arg
+
+# ---------------------------------------------------------------- disc form
+# The packed arrays and their per-contact kernels: :mod:`ncd.solver.pack`.
+
+
+def restitution_bias(contacts, U_initial):
+    """``e * U_i`` per component, for approaching contacts only (``U_i,n < 0``).
+
+    The law is imposed on Moreau's weighted mean ``(U_f + e U_i) / (1 + e)``;
+    since the Coulomb law is invariant under positive scaling of each velocity
+    component, this is the law on ``U_f + e U_i``.
+    """
+    return _restitution_bias(contacts.e_n, contacts.e_t, U_initial)
+
+
+@njit(cache=True)
+def _restitution_bias(e_n, e_t, U_initial):
+    """The loop of :func:`restitution_bias`."""
+    bias = np.zeros_like(U_initial)
+    for c in range(U_initial.shape[0]):
+        if U_initial[c, 0] < 0.0:
+            bias[c, 0] = e_n[c] * U_initial[c, 0]
+            bias[c, 1] = e_t[c] * U_initial[c, 1]
+    return bias
+
+
+@validate.finite_output
+def solve_discs(scene, contacts, vel, spin, guess=None, review_order=None,
+                settings=SolverSettings(), bias=None, W=None, observe=None):
+    """Solve the core problem of one step by NLGS in disc form.
+
+    ``vel, spin`` hold the free velocities on entry and the end-of-step
+    velocities ``u_f`` on return (modified in place).  ``guess`` is the initial
+    impulse array (n, 2) (zero if None); ``review_order`` a permutation of the
+    contacts (identity if None); ``bias`` the restitution term ``e U_i``;
+    ``observe(impulse, vel, spin)``: see :func:`ncd.solver.convergence.run_nlgs`.
+    """
+    guess, review_order, bias, W = check_disc_problem(scene, contacts, vel, spin, guess, review_order,
+                                                       settings, bias, W)
+    if observe is not None and not callable(observe):
+        raise InputError(f"observe = {observe!r} must be None or a callable (impulse, vel, spin) -> array")
+    n = contacts.n
+    impulse = np.zeros((n, 2)) if guess is None else np.array(guess, dtype=float).reshape(n, 2)
+    status = np.zeros(n, np.int8)
+    if n == 0:
+        return NLGSResult(impulse, status, 0, 0.0, 0.0, True)
+    order = np.arange(n) if review_order is None else np.asarray(review_order, dtype=np.int64)
+    bias = np.zeros((n, 2)) if bias is None else bias
+    c = contacts
+    W = delassus_blocks(c.body_a, c.body_b, c.arm_a, c.arm_b, scene.inv_mass, scene.inv_inertia) if W is None else W
+    q_free = local_velocity(c.body_a, c.body_b, c.normal, c.arm_a, c.arm_b, vel, spin, np.empty((n, 2))) + bias
+    pair, coef, body = pack_problem(c.body_a, c.body_b, c.normal, c.arm_a, c.arm_b, W, c.mu, bias,
+                                    scene.inv_mass, scene.inv_inertia, vel, spin)
+    flat = (pair.ravel(), coef.ravel(), body.ravel(), impulse.ravel())
+    iterate = iterate_discs
+    if settings.accel == "anderson" and settings.accel_memory > 0:
+        iterate = driver(flat, settings.accel_memory)      # before the guess: it keeps the free velocities
+    apply_all(*flat)
+    look = None if observe is None else (lambda: observe(impulse, body[:-1, :2], body[:-1, 2]))
+    local = None
+    if settings.local_exact:
+        nm = scene.n_mobile
+        local = LocalExact(scene, contacts, np.column_stack([vel[:nm], spin[:nm]]).ravel(), q_free, flat,
+                           getattr(iterate, "reset", None))
+        iterate = local.driver(iterate)
+    result = run_nlgs(iterate, flat, order, status, problem_scale(q_free, W), settings, look)
+    result.impulse = impulse
+    result.local_solves = 0 if local is None else local.solves
+    if settings.finish != "none":
+        result = polish_discs(scene, contacts, vel, spin, bias, q_free, W, flat, order, result, settings)
+    vel[:] = body[:-1, :2]
+    spin[:] = body[:-1, 2]
+    return result
+
+
+@validate.finite_output
+def solve_local(W, q, mu, guess=None, review_order=None, settings=SolverSettings()):
+    """NLGS on a 2-D frictional contact problem in local form.
+
+    Find ``s`` (n, 2) with ``U = W s + q`` and the Coulomb law at each contact.
+    ``W`` is (2n, 2n), dense or scipy.sparse, rows ordered (n_1, t_1, n_2, ...);
+    ``q`` (2n,); ``mu`` scalar or (n,).  Checks: :func:`ncd.check_local_problem`.
+    """
+    W, q, mu, guess, review_order = check_local_problem(W, q, mu, guess, review_order, settings)
+    if settings.accel != "none":
+        raise InputError(f"settings.accel = {settings.accel!r}: acceleration is implemented "
+                                "for the disc form (solve_discs, solve_problem) only")
+    if settings.local_exact:
+        raise InputError("settings.local_exact = True: local exact solves are implemented "
+                                "for the disc form (solve_discs, solve_problem) only")
+    if len(q) == 0:
+        return NLGSResult(np.zeros((0, 2)), np.zeros(0, np.int8), 0, 0.0, 0.0, True)
+    Wc = sp.csr_matrix(W, dtype=float)
+    q = np.asarray(q, dtype=float).ravel()
+    n = len(q) // 2
+    if Wc.shape != (2 * n, 2 * n) or len(q) != 2 * n:
+        raise ValueError(f"W has shape {Wc.shape}, q has length {len(q)}: expected (2n, 2n) and 2n")
+    mu = np.broadcast_to(np.asarray(mu, dtype=float), (n,)).copy()
+    if np.any(mu < 0):
+        raise ValueError(f"mu must be >= 0; got min {mu.min()}")
+    Wd = np.empty((n, 2, 2))
+    for i, j in ((0, 0), (0, 1), (1, 0), (1, 1)):
+        Wd[:, i, j] = Wc[np.arange(n) * 2 + i, np.arange(n) * 2 + j].A1
+    if np.any(Wd[:, 0, 0] <= 0) or np.any(Wd[:, 0, 0] * Wd[:, 1, 1] - Wd[:, 0, 1] * Wd[:, 1, 0] <= 0):
+        raise ValueError("the diagonal 2x2 blocks of W must be positive definite")
+    flat = np.zeros(2 * n) if guess is None else np.array(guess, dtype=float).ravel().copy()
+    order = np.arange(n) if review_order is None else np.asarray(review_order, dtype=np.int64)
+    status = np.zeros(n, np.int8)
+    data = (Wc.indptr.astype(np.int64), Wc.indices.astype(np.int64), Wc.data, q, Wd, mu, flat)
+    result = run_nlgs(iterate_local, data, order, status, problem_scale(q.reshape(n, 2), Wd), settings)
+    result.impulse = flat.reshape(n, 2)
+    if settings.finish != "none":
+        result = polish_local(Wc, q, mu, Wd, data, order, result, settings)
+    return result
+
+
+# ------------------------------------------------------------ the local form
+def check_local_problem(W, q, mu, guess, review_order, settings):
+    """All arguments of :func:`ncd.solve_local` (policy in the module docstring);
+    returns ``(Wc, q, mu, guess, order)`` with ``Wc`` CSR."""
+    q = array("q", q, (None,))
+    if len(q) % 2:
+        raise InputError(f"q has length {len(q)}, expected 2 n (rows n_1, t_1, n_2, ...)")
+    n = len(q) // 2
+    Wc = sparse_matrix("W", W) if sp.issparse(W) else None
+    shape = shape_of("W", W) if Wc is None else Wc.shape
+    if shape != (2 * n, 2 * n):
+        raise InputError(f"W has shape {shape}, q has length {len(q)}: expected (2n, 2n) and 2n")
+    if Wc is None:
+        Wc = sp.csr_matrix(array("W", W, shape))
+    mu = per_item("mu", mu, n, 0.0)
+    if n:
+        rows = np.arange(n) * 2
+        nn, nt = Wc[rows, rows].A1, Wc[rows, rows + 1].A1
+        tn, tt = Wc[rows + 1, rows].A1, Wc[rows + 1, rows + 1].A1
+        bad = ~((nn > 0) & (tt > 0) & (nn * tt > (0.5 * (nt + tn)) ** 2))
+        if np.any(bad):
+            k = int(np.argmax(bad))
+            raise InputError(f"the diagonal 2x2 blocks of W must be positive definite (x.Bx > 0); block {k} "
+                             f"= {[[float(nn[k]), float(nt[k])], [float(tn[k]), float(tt[k])]]} is not")
+    check_settings_arg(settings)
+    return Wc, q, mu, impulse_guess("guess", guess, n), permutation("review_order", review_order, n)
+
+
+def check_disc_problem(s, c, vel, spin, guess, review_order, settings, bias, W):
+    """All arguments of :func:`ncd.solve_discs`; returns ``(guess, order, bias)``."""
+    check_scene(s)
+    check_contacts(s, c)
+    n, nd = c.n, s.n_disc
+    for nm_, value, shape in (("vel", vel, (nd, 2)), ("spin", spin, (nd,))):
+        if not (isinstance(value, np.ndarray) and value.dtype == np.float64 and value.flags.writeable):
+            raise InputError(f"{nm_} must be a writeable float64 numpy array of shape {shape} (modified in place); "
+                             f"got {show(value)}")
+        array(nm_, value, shape)
+    check_settings_arg(settings)
+    W = None if W is None else check_disc_blocks(W, n)
+    bias = np.zeros((n, 2)) if bias is None else array("bias", bias, (n, 2))
+    return impulse_guess("guess", guess, n), permutation("review_order", review_order, n), bias, W

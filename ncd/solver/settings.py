@@ -1,0 +1,115 @@
+"""Solver settings and the result of one NLGS run: the types every solver shares.
+
+A :class:`SolverSettings` is checked once, when it is built (``__post_init__``), so
+that every entry point can trust an instance of the exact type (:func:`check_settings_arg`)
+and the kernels receive plain floats and ints.
+"""
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from ncd.core.errors import InputError
+from ncd.core.validate import integer, real, show
+
+CRITERIA = {"residual": 0, "change": 1}      # stopping criterion -> the kernels' code
+FINISHES = ("none", "active_set")            # finishing stage after NLGS (ncd.solver.finish)
+ACCELS = ("none", "anderson")                # the iteration: plain NLGS or Anderson-accelerated
+MAX_SWEEPS = 10 ** 9      # sweep budget at most (the kernels count sweeps in int64)
+MAX_ACCEL_MEMORY = 100    # stored differences of Anderson acceleration at most
+
+
+@dataclass(frozen=True)
+class SolverSettings:
+    """NLGS settings: tolerance on the chosen criterion, sweep budget, finishing stage.
+
+    ``finish``: "none" (plain NLGS) or "active_set" (:func:`ncd.solver.finish.polish`: where
+    NLGS's rate is slow, its iterate projected (L1, LP) on the solutions with the contact
+    statuses it has settled, the active set, until the natural-map residual is <= ``finish_tol``).
+    ``observable_tol``: largest relative change of an observed quantity over the
+    last residual checks for a run to count as converged (:mod:`ncd.solver.convergence`).
+    ``keep_best``: at ``max_sweeps`` return the iterate of smallest residual seen
+    (``False``: the last sweep's, as LMGC90 and Siconos do; the stability study's
+    setting, since time steps going on from the best iterate made its 10^6 stack gain energy).
+    ``accel``: "none" (plain NLGS) or "anderson" (:mod:`ncd.solver.anderson`: Anderson
+    acceleration of the sweeps with ``accel_memory`` stored differences, disc form only;
+    memory 0 is plain NLGS).
+    ``local_exact``: where the residual stalls, the contacts drifting most and their
+    grains' other contacts solved exactly by Lemke's method, the other impulses frozen
+    (:mod:`ncd.solver.local_exact`; disc form only).
+    """
+    tol: float = 1e-8
+    max_sweeps: int = 20000
+    criterion: str = "residual"   # "residual" (natural map) or "change"
+    check_every: int = 1          # sweeps between residual evaluations
+    finish: str = "none"          # "none" or "active_set"
+    finish_tol: float = 1e-10
+    observable_tol: float = 1e-6
+    keep_best: bool = True
+    accel: str = "none"           # "none" or "anderson"
+    accel_memory: int = 20
+    local_exact: bool = False
+
+    def __post_init__(self):
+        check_solver_settings(self)    # InputError naming the field
+
+    def as_attrs(self):
+        return {f"solver_{k}": int(v) if isinstance(v, bool) else v for k, v in asdict(self).items()}
+
+
+@dataclass
+class NLGSResult:
+    """Impulses ``(n, 2)`` (normal, tangential), final status per contact and diagnostics."""
+    impulse: np.ndarray
+    status: np.ndarray
+    sweeps: int
+    residual: float
+    change: float
+    converged: bool
+    finish_rounds: int = 0                  # LP projections of the finishing stage (0: none)
+    finish_correction: float = 0.0          # relative L1 size of the accepted projection (0: none)
+    observable_change: float = float("nan")  # relative change of the observable (nan: not observed)
+    best_sweep: int = 0                     # sweep of the returned iterate (keep_best), 0: the last
+    local_solves: int = 0                   # local exact solves (ncd.solver.local_exact; 0: none)
+
+    @property
+    def impulse_n(self):
+        return self.impulse[:, 0]
+
+    @property
+    def impulse_t(self):
+        return self.impulse[:, 1]
+
+
+def check_solver_settings(settings, name="settings"):
+    """Field checks of :class:`SolverSettings` (run by its ``__post_init__``). Values are
+    stored back as plain float / int (frozen dataclass: ``object.__setattr__``), so that
+    later checks, kernels and netCDF attributes see one type whatever the caller passed."""
+    if not isinstance(settings, SolverSettings):
+        raise InputError(f"{name} must be an ncd.SolverSettings; got {show(settings)}")
+    object.__setattr__(settings, "tol", real(f"{name}.tol", settings.tol, 0.0, lo_open=True))
+    object.__setattr__(settings, "max_sweeps", integer(f"{name}.max_sweeps", settings.max_sweeps, 1, MAX_SWEEPS))
+    object.__setattr__(settings, "check_every", integer(f"{name}.check_every", settings.check_every, 1, MAX_SWEEPS))
+    if not isinstance(settings.criterion, str) or settings.criterion not in CRITERIA:
+        raise InputError(f"{name}.criterion = {settings.criterion!r} must be one of {sorted(CRITERIA)}")
+    if not isinstance(settings.finish, str) or settings.finish not in FINISHES:
+        raise InputError(f"{name}.finish = {settings.finish!r} must be one of {FINISHES}")
+    for field in ("finish_tol", "observable_tol"):
+        object.__setattr__(settings, field, real(f"{name}.{field}", getattr(settings, field), 0.0, lo_open=True))
+    for field in ("keep_best", "local_exact"):
+        if not isinstance(getattr(settings, field), (bool, np.bool_)):
+            raise InputError(f"{name}.{field} = {getattr(settings, field)!r} must be True or False")
+    if not isinstance(settings.accel, str) or settings.accel not in ACCELS:
+        raise InputError(f"{name}.accel = {settings.accel!r} must be one of {ACCELS}")
+    object.__setattr__(settings, "accel_memory",
+                       integer(f"{name}.accel_memory", settings.accel_memory, 0, MAX_ACCEL_MEMORY))
+    return settings
+
+
+def check_settings_arg(settings, name="settings"):
+    """A :class:`SolverSettings` argument. An instance of the exact type was checked when
+    it was built (and is frozen); a subclass's instance is checked again."""
+    if type(settings) is not SolverSettings:
+        if not isinstance(settings, SolverSettings):
+            raise InputError(f"{name} must be an ncd.SolverSettings; got {show(settings)}")
+        check_solver_settings(settings, name)
+    return settings
