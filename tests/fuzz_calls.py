@@ -1,4 +1,4 @@
-"""Random malformed calls of the public API, for :mod:`test_fuzz` (issue 14).
+"""Random malformed calls of the public API, for :mod:`test_fuzz`.
 
 ``call(entry, rng)`` draws one call of ``entry`` from a valid baseline (small
 random scenes: overlapping discs, mass ratios up to 1e12, periodic or walled,

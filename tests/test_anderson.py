@@ -1,4 +1,4 @@
-"""Anderson-accelerated NLGS (issue 13 item 2, ``SolverSettings(accel="anderson")``)."""
+"""Anderson-accelerated NLGS (``SolverSettings(accel="anderson")``)."""
 import numpy as np
 import pytest
 from step_checks import contact_velocities as _velocities

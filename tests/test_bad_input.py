@@ -1,6 +1,6 @@
 """Physically invalid input raises ncd.InputError naming the offending key and
 value; a state that goes non-finite or diverges while stepping raises
-ncd.SimulationError instead of returning NaN (issue 2, "Bad input")."""
+ncd.SimulationError instead of returning NaN."""
 import re
 
 import numpy as np
@@ -133,7 +133,7 @@ def test_solver_settings_and_local_form_reject():
         ncd.solve_local(np.eye(2), np.zeros(4), 0.5)
 
 
-# ------------------------------------------------ issue 14: regressions of each reproduced fault
+# ------------------------------------------ regressions of faults that crashed the interpreter
 def run_isolated(code):
     """Run ``code`` in a fresh interpreter: a segfault or abort is a failure of the
     test, not of the runner.  Returns its stdout (rc 0 asserted)."""
@@ -146,13 +146,13 @@ def run_isolated(code):
 
 
 ISOLATED = {
-    # segfault (rc 139) before issue 14: index 10**6 read by the NLGS sweep
+    # a segfault (rc 139) without the check: index 10**6 read by the NLGS sweep
     "review_order_local": "ncd.solve_local(2.0 * np.eye(6), -np.ones(6), 0.5, review_order=[0, 1, 10**6])",
     "review_order_problem": ("s = ncd.make_scene([[0.0, 0.5], [1.0, 0.5], [2.0, 0.5]], 0.5, walls=[((0, 0), (0, 1))])\n"
                              "p = ncd.prepare_step(s, 1e-3)\n"
                              "assert p.contacts.n == 5\n"
                              "ncd.solve_problem(s, p, review_order=[0, 1, 10**6, 2, 3])"),
-    # heap corruption (rc 134/139) before: a guess of 3 values for 3 contacts
+    # heap corruption (rc 134/139) without the check: a guess of 3 values for 3 contacts
     "guess": "ncd.solve_local(2.0 * np.eye(6), -np.ones(6), 0.5, guess=np.ones(3))",
 }
 MESSAGES = {
@@ -164,7 +164,7 @@ MESSAGES = {
 
 @pytest.mark.parametrize("case", sorted(ISOLATED))
 def test_crash_regressions_raise_input_error(case):
-    """Each crash of issue 14, in a subprocess: now an InputError naming the argument."""
+    """Each crashing call, in a subprocess: an InputError naming the argument."""
     code = ("try:\n" + "".join(f"    {line}\n" for line in ISOLATED[case].splitlines())
             + "except ncd.InputError as err:\n    print('InputError:', err)\nelse:\n    print('accepted')\n")
     out = run_isolated(code)
@@ -186,7 +186,7 @@ def test_review_order_of_right_length_but_out_of_range():
     ("01", r"got shape \(\)"),
 ])
 def test_review_order_must_be_a_permutation(order, pattern):
-    """[0, 0] used to skip contact 1 silently (20,000 sweeps, residual 0.52)."""
+    """An order such as [0, 0] would skip contact 1 silently: it is refused."""
     W, q = 2.0 * np.eye(4), -np.ones(4)
     with pytest.raises(ncd.InputError, match=pattern):
         ncd.solve_local(W, q, 0.5, review_order=order)
@@ -200,7 +200,7 @@ def test_review_order_must_be_a_permutation(order, pattern):
 @pytest.mark.parametrize("where", ["W", "q"])
 @pytest.mark.parametrize("value", [np.nan, np.inf])
 def test_non_finite_local_problem_refused_up_front(where, value):
-    """NaN in W or q used to run 20,000 sweeps and return NaN."""
+    """NaN in W or q is refused before any sweep (unchecked, it runs every sweep and returns NaN)."""
     W, q = 2.0 * np.eye(6), -np.ones(6)
     (W if where == "W" else q)[(0, 3) if where == "W" else 1] = value
     with pytest.raises(ncd.InputError, match=rf"{where} must be finite; {where}\[.*\] = {value}"):
@@ -223,7 +223,7 @@ def test_mu_must_be_finite_and_non_negative(mu):
 
 
 def test_gap_tolerance_nan_is_refused():
-    """step(gap_tolerance=nan) used to drop every contact and report converged=True."""
+    """step(gap_tolerance=nan) is refused: it would drop every contact and report converged=True."""
     s = scene()
     for tol in (np.nan, -1e-3, np.inf):
         with pytest.raises(ncd.InputError, match=rf"gap_tolerance = {tol} is outside \[0\.0, inf\]"):
@@ -235,13 +235,13 @@ def test_gap_tolerance_nan_is_refused():
 
 @pytest.mark.parametrize("pos", [np.zeros((2, 3)), np.zeros(4), np.zeros((1, 2, 2)), [[0.0, 0.5], [1.0]]])
 def test_pos_must_have_shape_n_by_2(pos):
-    """pos of shape (2, 3) used to be read as 3 discs."""
+    """pos of shape (2, 3) is not read as 3 discs."""
     with pytest.raises(ncd.InputError, match=r"pos (has shape|= ).*"):
         ncd.make_scene(pos, 0.1)
 
 
 def test_empty_local_problem_returns_an_empty_converged_result():
-    """It used to raise AttributeError."""
+    """An empty problem is solved trivially, not an AttributeError."""
     for W in (np.zeros((0, 0)), __import__("scipy.sparse").sparse.csr_matrix((0, 0))):
         r = ncd.solve_local(W, np.zeros(0), 0.5)
         assert r.impulse.shape == (0, 2) and r.status.shape == (0,)

@@ -1,4 +1,4 @@
-"""The benchmark suite (issue 6): what it measures must be right; its speed is not asserted.
+"""The benchmark suite: what it measures must be right; its speed is not asserted.
 
 Unit checks of ncd.studies.bench on small packings, and checks of the data of the
 reduced DAG run (``snakemake -j2 bench`` in tests/conftest.py)."""
@@ -129,7 +129,7 @@ def test_bench_rules_cover_every_figure(bench_results):
 
 
 def test_tolerance_table_both_methods_reach_the_tolerance():
-    """Time to tolerance (issue 13): plain NLGS and NLGS + finishing stage, side by side."""
+    """Time to tolerance: plain NLGS and NLGS + finishing stage, side by side."""
     from ncd.studies.bench import tolerance_table
     ds = tolerance_table({"sizes": [100], "tolerances": [1e-6, 1e-10], "handoff": 1e-4, "max_sweeps": 100000})
     assert ds.converged.values.all()
@@ -143,7 +143,7 @@ def test_tolerance_table_both_methods_reach_the_tolerance():
 
 
 def test_tolerance_problems_local_solves(results):
-    """The figures' problems side by side (issue 13): every run stopping as converged is at
+    """The figures' problems side by side: every run stopping as converged is at
     or below its tolerance; plain NLGS is at distance 0 from itself; a run with local exact
     solves enabled that made none is plain NLGS sweep for sweep (the chunks of the stall test
     do not change the sweeps; Anderson's do: no extrapolation after a chunk's last sweep); the warm-started

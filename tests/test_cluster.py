@@ -1,4 +1,4 @@
-"""A real Slurm cluster (issue 14, item 5): the sharded fig1 ensemble run with
+"""A real Slurm cluster: the sharded fig1 ensemble run with
 ``snakemake --executor slurm`` (profile workflow/profiles/slurm) on the single-node
 cluster of scripts/slurm/start.sh equals a local run, data and attributes.
 

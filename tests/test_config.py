@@ -1,4 +1,4 @@
-"""Config checks before any job (issue 14, items 2 and 6): the ten malformed configs
+"""Config checks before any job: the ten malformed configs
 that passed the JSON schemas, errors naming section and key, a missing section."""
 import copy
 import math
@@ -39,7 +39,7 @@ def test_the_shipped_configs_pass():
     assert issubclass(ConfigError, InputError) and issubclass(ConfigError, ValueError)
 
 
-# the ten configs of issue 14 that planned jobs, with the text the error must hold
+# the ten configs that passed the schemas and planned jobs, with the text the error must hold
 SLIPPED = [
     ("fig1_wedged: {mu: .nan}", "fig1_wedged.mu = nan"),
     ("fig1_wedged: {mu: .inf}", "fig1_wedged.mu = inf"),
@@ -115,7 +115,7 @@ def test_snakemake_stops_before_any_job_naming_the_key(fresh_repo, tmp_path):
 
 
 def test_a_removed_figure_section_stops_the_run(fresh_repo):
-    """``all`` used to plan without the figure; now the run stops naming the section."""
+    """Without a figure's section the run stops naming the section (rather than planning without it)."""
     config = fresh_repo / "config.yaml"
     data = yaml.safe_load(config.read_text())
     del data["fig1_wedged"]

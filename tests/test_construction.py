@@ -1,4 +1,4 @@
-"""Issue 16, speed of the pile construction: what the faster construction keeps.
+"""Speed of the pile construction: what its shortcuts keep.
 
 * a construction step solved to the configured tolerance stays within a few ``g h`` of
   the converged step (the stated per-step accuracy of ``construction.settings``);

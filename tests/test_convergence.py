@@ -1,4 +1,4 @@
-"""Convergence record (issue 13 item 1) and best iterate (issue 14 item 4)."""
+"""Convergence record and best iterate (``keep_best``)."""
 import numpy as np
 import pytest
 

@@ -1,4 +1,4 @@
-"""Issue 16: piles of two construction histories, checkpoint/restart, ensemble statistics.
+"""Piles of two construction histories, checkpoint/restart, ensemble statistics.
 
 Unit tests on small piles and hand-made profiles, then checks on the figure data
 of a whole-DAG run (fixture ``results``).

@@ -1,4 +1,4 @@
-"""Figure 5 (issue 15): exact measures of A ∩ C across friction, and Unger et al.'s eta.
+"""Figure 5: exact measures of A ∩ C across friction, and Unger et al.'s eta.
 
 Unit tests of :mod:`ncd.figures.governing_exact` on problems with a known answer and on
 a frictionless packing, then the claims of the figure on the data of the DAG run
@@ -147,7 +147,7 @@ def test_eta_small_friction_below_peak(packings):
         assert t[0, 1] < 0.8 * np.nanmax(t[:, 1])
 
 
-# ---------------------------------------------------------------- why a line (item 3)
+# ---------------------------------------------------------------------------- why a line
 
 
 def _chain_case():

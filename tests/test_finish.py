@@ -1,4 +1,4 @@
-"""Finishing stage (issue 13 item 2): NLGS, then the projection on its statuses' polyhedron (LP)."""
+"""Finishing stage: NLGS, then the projection on its statuses' polyhedron (LP)."""
 import numpy as np
 import pytest
 from step_checks import contact_velocities as _velocities

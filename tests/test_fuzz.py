@@ -1,4 +1,4 @@
-"""Fuzz test of the public API (issue 14, item 3): random malformed calls never
+"""Fuzz test of the public API: random malformed calls never
 crash, hang or return NaN.
 
 A seeded generator (:mod:`fuzz_calls`) (``default_rng((batch, ROOT))``, no test order dependence)
@@ -22,8 +22,7 @@ budget (``max_sweeps <= 300``, so no hang).  The subprocesses run with
 directory, so that kernels compiled without bounds checks are not loaded): an
 out-of-range index inside a kernel is then an ``IndexError`` (a failure here)
 instead of memory corruption.  Compiling the kernels with bounds checks costs
-about a minute, paid once by the first batch; the whole test takes about two to
-three minutes on two loaded cores (see the report of issue 14).
+about a minute, paid once by the first batch.
 """
 import json
 import os

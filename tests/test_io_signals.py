@@ -1,6 +1,6 @@
 """A signal during ncd.io.netcdf.write_dataset leaves neither a partial file nor a hung process.
 
-Policy (ncd/io.py): SIGTERM/SIGINT remove the ``.<name>.<pid>.part`` file and end the
+Policy (ncd/io/netcdf.py): SIGTERM/SIGINT remove the ``.<name>.<pid>.part`` file and end the
 process with that signal; SIGKILL leaves it, and the next write of the same target
 removes it.
 """

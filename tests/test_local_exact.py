@@ -1,4 +1,4 @@
-"""Local exact solves where NLGS stalls (issue 13 item 2, ``SolverSettings(local_exact=True)``).
+"""Local exact solves where NLGS stalls (``SolverSettings(local_exact=True)``).
 
 The problem is Figure 2's investigated step at the default configuration
 (``tests/data/fig2_step50.nc``: the state before it, 355 discs, 552 contacts), started

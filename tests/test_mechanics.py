@@ -1,4 +1,4 @@
-"""Checks of ncd against closed-form mechanics (issue 2, "Verify").
+"""Checks of ncd against closed-form mechanics.
 
 Every test derives its expected numbers in its docstring and asserts them with
 tolerances that a wrong sign, a missing factor or a wrong contact law would

@@ -85,7 +85,7 @@ def test_no_hand_typed_numbers_in_prose(py):
 
 
 def test_hand_typed_number_is_noticed():
-    """The check fails on a stale sentence such as the issue's 'about 60 % and 95 %' (not in maths,
+    """The check fails on a stale sentence such as 'about 60 % and 95 %' (not in maths,
     and not in the introduction), and passes the same numbers inside maths or code."""
     text = ("# %% [markdown]\n# intro 60 %\n\n# %%\nx = 1\n\n# %% [markdown]\n"
             "# The clouds cover about 60 % and 95 %; $h = 0.3$ ms is `tol: 1.5`.\n")

@@ -34,7 +34,7 @@ def test_same_scene_and_ncd_at_rest(small):
     assert int(ncd_["n_steps"]) == int(pm["n_steps"]) == 39 * 64 + 1000
     # ncd ends exactly at rest (KE ~1e-34 measured): the last step's ground and wall
     # impulses then balance the weight to rounding (|1 - R/W| ~1e-16 measured); 1e-6
-    # would still pass a last step a little off rest, 1 % (the brief) is far too loose
+    # would still pass a last step a little off rest, 1 % would be far too loose
     assert float(ncd_["kinetic_energy"]) < 1e-20
     assert float(ncd_["ground_reaction"]) == pytest.approx(1.0, abs=1e-6)
     # NLGS solves each contact exactly in the Coulomb cone (measured 0)
@@ -43,7 +43,7 @@ def test_same_scene_and_ncd_at_rest(small):
     # ncd never corrects positions: an approaching disc penetrates at most v h before
     # Moreau's rule activates its contact, and no disc moves faster than a fall from the
     # release point (at most pile height + 2 d_max above the ground).  Measured
-    # 0.05-0.067 d against a bound of ~0.12 d; a tolerance of 1e-3 d (the brief) is out
+    # 0.05-0.067 d against a bound of ~0.12 d; a tolerance of 1e-3 d is out
     # of reach for any h that pours 1000 discs in a minute.
     v_max = np.sqrt(2 * cfg["gravity"] * (float(ncd_["pile_height"]) + 3) * cfg["diameter"])
     assert 0 < float(ncd_["overlap_max"]) < v_max * cfg["h"] / cfg["diameter"]

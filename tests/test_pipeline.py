@@ -154,41 +154,47 @@ def test_an_ensemble_does_not_depend_on_shards_threads_or_jobs(dag_repo, tmp_pat
     xr.testing.assert_identical(ref.drop_vars(timing).drop_attrs(), new.drop_vars(timing).drop_attrs())
 
 
-def test_every_ncd_module_is_a_source_of_the_figures_that_import_it():
-    """NCD_MODULES (common.smk) lists, per figure, the modules outside the core its
-    rules depend on; a module imported by a listed one must be listed too, and every
-    module of ncd/figures and ncd/studies belongs to some figure."""
-    import ast
+def smk_table(name):
+    """A literal table of workflow/rules/common.smk (STUDY_MODULES, LOWER_LAYERS...)."""
     text = (ROOT / "workflow" / "rules" / "common.smk").read_text()
-    modules = ast.literal_eval(re.search(r"NCD_MODULES = (\{.*?\n\})", text, re.S).group(1))
+    block = re.search(rf"^{name} = (.*\n(?:[ \t].*\n)*(?:[}})\]].*)?)", text, re.M).group(1)
+    return ast.literal_eval(block)
+
+
+def test_every_study_module_is_a_source_of_the_studies_that_import_it():
+    """STUDY_MODULES (common.smk) lists, per study, its modules of ncd/studies; a study
+    module imported by a listed one must be listed too, and every module of ncd/studies
+    belongs to some study.  (Figure modules: ncd.figures.FIGURE_MODULES, tests/test_layers.py.)"""
+    modules = smk_table("STUDY_MODULES")
     listed = set()
-    for figure, files in modules.items():
+    for study, files in modules.items():
         listed.update(files)
         for f in files:
             if not f.endswith(".py"):
                 continue
-            tree = ast.parse((ROOT / "ncd" / f).read_text())
-            pkg = f.split("/")[0]
-            for node in ast.walk(tree):
-                if isinstance(node, ast.ImportFrom):
-                    mod = node.module or ""
-                    if node.level == 1:            # from . import x / from .x import y
-                        names = [mod] if mod else [a.name for a in node.names]
-                        deps = [f"{pkg}/{n}.py" for n in names]
-                    elif mod.startswith("ncd.figures.") or mod.startswith("ncd.studies."):
-                        deps = [mod[4:].replace(".", "/") + ".py"]
-                    else:
-                        continue
+            for node in ast.walk(ast.parse((ROOT / "ncd" / "studies" / f).read_text())):
+                if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("ncd.studies"):
+                    deps = ([f"{node.module[12:]}.py"] if node.module != "ncd.studies"
+                            else [f"{a.name}.py" for a in node.names])
                     for d in deps:
-                        assert d in files, f"{figure}: {f} imports {d}, not in NCD_MODULES[{figure!r}]"
-    own = {str(p.relative_to(ROOT / "ncd")) for d in ("figures", "studies") for p in (ROOT / "ncd" / d).iterdir()
-           if p.suffix in (".py", ".c")}
+                        assert d in files, f"{study}: {f} imports {d}, not in STUDY_MODULES[{study!r}]"
+    own = {p.name for p in (ROOT / "ncd" / "studies").iterdir() if p.suffix in (".py", ".c") and p.stem != "__init__"}
     assert own == listed, own ^ listed
 
 
+def test_the_computing_rules_depend_on_the_lower_layers_only():
+    """Every subpackage below the figures is a source of every computing rule, and none
+    above (pages, studies, figures) is in that common list."""
+    layers = smk_table("LOWER_LAYERS")
+    import tomllib
+    order = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["importlinter"]["contracts"][0]["layers"]
+    below = [n.strip() for layer in order[order.index("scenes"):] for n in layer.split("|")]
+    assert sorted(layers) == sorted(below)
+
+
 ALL_FIGURES = FIGURES + [f for f in ("stability", "error_vs_runtime") if f in CONFIG]
-OWN_MODULE = {"fig1_wedged": "figures/wedged.py", "fig2_slope": "figures/slope_analysis.py",
-              "fig3_equilibrium": "figures/equilibrium.py", "fig4_pile": "figures/cuts.py",
+OWN_MODULE = {"fig1_wedged": "figures/wedged.py", "fig2_slope": "figures/census.py",
+              "fig3_equilibrium": "figures/equilibrium.py", "fig4_pile": "figures/pile.py",
               "stability": "studies/stability.py", "error_vs_runtime": "studies/work_precision.py"}
 
 
@@ -199,38 +205,50 @@ def test_a_figure_target_plans_only_its_own_rules(fresh_repo, figure):
     assert all(r.startswith(figure) or r in SHARED for r in jobs), jobs
 
 
+def plan_after_editing(repo, rel):
+    """The jobs a dry run plans after an edit of ``ncd/<rel>`` (a new mtime and new
+    content: Snakemake skips a newer file whose checksum it recorded unchanged), undone
+    afterwards with its mtime."""
+    path = repo / "ncd" / rel
+    original, st = path.read_text(), path.stat()
+    try:
+        path.write_text(original + "\n# an edit\n")
+        os.utime(path, ns=(st.st_atime_ns, time.time_ns() + 10**12))     # newer than any output
+        return planned_jobs(run_snakemake(repo, "-n"))
+    finally:
+        path.write_text(original)
+        os.utime(path, ns=(st.st_atime_ns, st.st_mtime_ns))
+
+
 @pytest.mark.parametrize("figure", ALL_FIGURES)
 def test_editing_a_figure_module_reruns_that_figure_only(dag_repo, figure):
-    """A newer ncd/figures (or studies) module reruns its figure's computing rules and
-    nothing of the other figures; a newer core module reruns every figure."""
-    def plan_after_touching(rel):
-        # an edit (a new mtime and new content: Snakemake 9 skips a newer file whose
-        # checksum it recorded unchanged), undone afterwards with its mtime
-        path = dag_repo / "ncd" / rel
-        original, st = path.read_text(), path.stat()
-        try:
-            path.write_text(original + "\n# an edit\n")
-            os.utime(path, ns=(st.st_atime_ns, time.time_ns() + 10**12))     # newer than any output
-            return planned_jobs(run_snakemake(dag_repo, "-n"))
-        finally:
-            path.write_text(original)
-            os.utime(path, ns=(st.st_atime_ns, st.st_mtime_ns))
-
-    jobs = plan_after_touching(OWN_MODULE[figure])
+    """A newer module of a figure (or study) reruns that figure's computing rules and
+    nothing of the other figures; a newer solver module reruns every figure."""
+    jobs = plan_after_editing(dag_repo, OWN_MODULE[figure])
     assert any(r.startswith(figure) and not r.endswith("notebook") for r in jobs), jobs
-    # the figures whose rules list that module (a figure building on another's module,
-    # e.g. fig5 on fig3's packings or fig4_history on fig4's construction, reruns too)
-    text = (ROOT / "workflow" / "rules" / "common.smk").read_text()
-    modules = ast.literal_eval(re.search(r"NCD_MODULES = (\{.*?\n\})", text, re.S).group(1))
-    users = {f for f, files in modules.items() if OWN_MODULE[figure] in files}
-    assert figure in users
-    assert all(any(r.startswith(f) for f in users) or r in SHARED for r in jobs), (jobs, users)
+    assert all(r.startswith(figure) or r in SHARED for r in jobs), jobs
     if figure == ALL_FIGURES[0]:
-        core = plan_after_touching("nlgs.py")
+        core = plan_after_editing(dag_repo, "solver/nlgs.py")
         assert {f"{f}_notebook" for f in ALL_FIGURES} <= set(core), core
 
 
-# --- shards, provenance, logs, interrupted runs (issue 14, items 6 and 7) ---------------
+@pytest.mark.parametrize("module, rules", [
+    ("pages/report.py", {"index"}),
+    ("pages/render.py", {"render_html", "index"}),
+    ("pages/notebook.py", None),           # every notebook rule, render_html, index
+])
+def test_editing_a_page_module_reruns_only_page_rules(dag_repo, module, rules):
+    """Page modules are inputs of the page rules only: no simulation, exploration or
+    analysis is planned after an edit of one."""
+    jobs = set(plan_after_editing(dag_repo, module)) - {"all"}
+    if rules is None:
+        assert jobs and all(r.endswith("notebook") or r in ("render_html", "index") for r in jobs), jobs
+        assert {f"{f}_notebook" for f in ALL_FIGURES} <= jobs, jobs
+    else:
+        assert jobs == rules, jobs
+
+
+# --- shards, provenance, logs, interrupted runs ------------------------------------------
 
 SHARDED = {"fig1_wedged": ("ensemble",), "fig2_slope": ("explore",), "fig3_equilibrium": ("modes", "zero"),
            "fig4_pile": ("ensemble",)}

@@ -1,4 +1,4 @@
-"""Issue 5: the MD baseline, the stability table and the work-precision data.
+"""The MD baseline, the stability table and the work-precision data.
 
 Unit tests of :mod:`ncd.dynamics.md` run in a second; the others read the results of a DAG
 run (fixture ``results``: the reduced configuration, or ``NCD_RESULTS_DIR``).

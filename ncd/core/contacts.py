@@ -227,6 +227,7 @@ def h_matrix(scene, contacts):
                          shape=(3 * nm, 2 * c.n))
 
 
+# ------------------------------------------------------------ argument checks
 def check_contacts(s, c, name="contacts"):
     """A :class:`ncd.Contacts` of ``s``: every field of length ``n``, disc
     indices in range (``body_a`` mobile, ``body_b`` a disc or ``-1 - wall``),
@@ -273,7 +274,7 @@ def check_contacts(s, c, name="contacts"):
 
 
 def _contacts_ok(s, c):
-    """Fast path of :func:`contacts` (False: the slow path names the fault)."""
+    """Fast path of :func:`check_contacts` (False: the slow path names the fault)."""
     a, b, key = c.body_a, c.body_b, c.key
     if type(a) is not np.ndarray or a.ndim != 1 or a.dtype != np.int64:
         return False

@@ -125,6 +125,7 @@ def disc_pairs(pos, radius, n_mobile, alert=0.0, period=0.0):
     return a, b, shift
 
 
+# ------------------------------------------------------------ argument checks
 MAX_GRID_CELLS = 1e7      # cells of the contact detection grid (8 bytes each)
 
 

@@ -5,9 +5,10 @@ value, raised before any kernel runs; :class:`SimulationError` is a state that w
 non-finite or a solver that diverged, never silent NaN.
 """
 
+
 class InputError(ValueError):
-    """A scene, a parameter or a configuration that is physically invalid."""
+    """An argument, a scene or a configuration that is invalid (type, shape, range or physics)."""
 
 
 class SimulationError(RuntimeError):
-    """A state that went non-finite or diverged during stepping."""
+    """A state that went non-finite, or a solver that diverged, during stepping or solving."""

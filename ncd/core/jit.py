@@ -2,8 +2,8 @@
 
 numba keys a cached function on its own file only (modification time and size): a
 kernel that inlines or calls a function of another module keeps its stale machine code
-when only that other module changes, so an edit of ``single_contact.py`` would not reach
-the NLGS sweep of ``kernels.py``.  The :func:`njit` below is numba's, with the cache
+when only that other module changes, so an edit of :mod:`ncd.solver.single_contact` would
+not reach the NLGS sweep of :mod:`ncd.solver.kernels`.  The :func:`njit` below is numba's, with the cache
 directory set, while a function is decorated, to
 ``<NUMBA_CACHE_DIR or ncd/__pycache__>/numba-<digest>``, the digest being that of every
 source file of the kernel layers (:data:`KERNEL_LAYERS`): an edit there gives every

@@ -20,7 +20,7 @@ from ncd.core.validate import F64, all_finite, array, first_bad, integer, is_f64
 class Scene:
     """Discs, obstacles, walls and the contact laws of one scene, plus its state.
 
-    Build with :func:`make_scene`; the arrays below are then consistent and
+    Build with :func:`ncd.core.scene.make_scene`; the arrays below are then consistent and
     validated.  ``pos, angle, vel, spin`` are the state of the mobile discs and
     are advanced in place by :func:`ncd.dynamics.stepper.step`.
     """
@@ -62,6 +62,7 @@ class Scene:
         return Scene(**kw)
 
 
+# ------------------------------------------------------------ argument checks
 MASS_RTOL = 1e-12         # |mass inv_mass - 1| of a mobile disc (make_scene: 1 / mass, a rounding at most)
 
 
@@ -91,7 +92,7 @@ def check_period(name, value, largest_radius):
 
 
 def _scene_ok(s):
-    """Fast path of :func:`scene` (a few microseconds): True if every check passes;
+    """Fast path of :func:`check_scene` (a few microseconds): True if every check passes;
     False sends the scene to the slow path, which names what is wrong."""
     r, nm = s.radius, s.n_mobile
     if type(r) is not np.ndarray or r.ndim != 1 or r.dtype != F64 or type(nm) is not int:
@@ -133,7 +134,7 @@ def _scene_values_ok(r, inv_mass, inv_inertia, mass, nm, wp, wn, g):
 
 
 def _scene_slow(s, name):
-    """The checks of :func:`scene` one by one, raising on the first that fails."""
+    """The checks of :func:`check_scene` one by one, raising on the first that fails."""
     rshape = shape_of(f"{name}.radius", s.radius)
     nd = rshape[0] if len(rshape) == 1 else -1
     if nd < 1:

@@ -1,26 +1,18 @@
-"""Checks of the arguments of the public API (issue 14: unbreakable inputs).
+"""Argument primitives shared by every layer: reals, integers, arrays, sparse matrices,
+permutations, impulse guesses, and the decorators that turn non-finite results into errors.
 
-Every public entry point calls these first, so that no numba kernel is ever
-reached with inconsistent sizes, out-of-range indices or non-finite data.  Each
-check raises :class:`ncd.InputError` (a ``ValueError``) naming the argument and
-the offending value, and returns the argument in the form the kernels read.
-
-Policies:
-
-* arrays must hold real numbers (no strings, booleans, complex or ragged lists)
-  and have exactly the stated shape (``pos`` of shape (2, 3) is refused, never
-  reshaped); scalars are real, finite, within the stated range;
-* a ``review_order`` is a permutation of ``range(n)`` of integer dtype;
-* an impulse guess has shape ``(n, 2)`` or the flat ``(2 n,)`` of ``q``;
-* a Delassus matrix ``W`` given to :func:`ncd.solve_local` is square ``2 n``,
-  finite, and each diagonal 2x2 block ``B`` (the contact's own) is positive
-  definite in the sense ``x . B x > 0`` for ``x != 0``, i.e. its symmetric part
-  is: ``B_nn > 0``, ``B_tt > 0``, ``B_nn B_tt > ((B_nt + B_tn) / 2)^2``.
-  Non-symmetric blocks (which the single-contact solver of
-  :mod:`ncd.solver.single_contact` handles) are accepted under this condition, which
-  makes the block invertible (``det B = det S + a^2 > 0``).  The coupling blocks
-  are not checked: an NLGS that diverges on them ends in
-  :class:`ncd.SimulationError` (:func:`finite_result`), never in silent NaN.
+Every public entry point checks its arguments first, so that no numba kernel is reached
+with inconsistent sizes, out-of-range indices or non-finite data.  A check raises
+:class:`ncd.InputError` naming the argument and the offending value, and returns the
+argument in the form the kernels read.  Policy: arrays hold real numbers (no strings,
+booleans, complex or ragged lists) and have exactly the stated shape (never reshaped);
+scalars are real, finite and in range; a ``review_order`` is an integer permutation of
+``range(n)``; an impulse guess is ``(n, 2)`` or flat ``(2 n,)``.  A solver that diverges
+anyway ends in :class:`ncd.SimulationError` (:func:`finite_result`), never in silent NaN.
+Each type's own checks live beside it: Scene in :mod:`ncd.core.model`, Contacts in
+:mod:`ncd.core.contacts`, SolverSettings in :mod:`ncd.solver.settings`, the local form's
+``W`` in :mod:`ncd.solver.nlgs`, steps in :mod:`ncd.dynamics.stepper`, ensembles in
+:mod:`ncd.dynamics.explore`.
 """
 import numbers
 

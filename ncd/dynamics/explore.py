@@ -138,6 +138,7 @@ def explore(scene, problem, members, root_seed, init="zero", review="random", gu
     return out
 
 
+# ------------------------------------------------------------ argument checks
 def check_explore_args(s, problem, members, root_seed, init, review, guess_scale, settings, progress, threads):
     """Arguments of :func:`ncd.dynamics.explore.explore`; returns ``members`` as int64."""
     check_step_problem(s, problem, full=True)

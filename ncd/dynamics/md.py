@@ -2,29 +2,25 @@
 
 Only for comparison with Contact Dynamics (Moreau 2005, section 2: MD "approximates
 the impenetrability constraints ... by repulsion forces steeply dependent on the
-mutual positions").  It runs on the same :class:`ncd.core.model.Scene` objects and uses
-the contact frames of :mod:`ncd.core.contacts` (normal from b to a, ``t = (-n_y, n_x)``,
-``U_t = (v_a - v_b).t - r_a w_a - r_b w_b``).  With the overlap ``delta = -gap > 0``:
+mutual positions").  It runs on the same :class:`ncd.core.model.Scene` and the contact
+frames of :mod:`ncd.core.contacts`.  With the overlap ``delta = -gap > 0``:
 
-* normal, linear spring-dashpot:  ``f_n = k_n delta - c_n U_n``  (clipped at 0 unless
+* normal spring-dashpot ``f_n = k_n delta - c_n U_n`` (clipped at 0 unless
   ``clip=False``), ``c_n = 2 zeta sqrt(k_n m_eff)``, ``m_eff = m_a m_b / (m_a + m_b)``
   (``m_a`` against walls and fixed discs);
-* tangential spring with a Coulomb slider (Cundall & Strack 1979):
-  ``xi += h U_t``, ``f_t = -k_t xi - c_t U_t``; if ``|f_t| > mu f_n`` then
-  ``f_t = +-mu f_n`` and the spring is reset to ``xi = -(f_t + c_t U_t) / k_t``;
-* the damping ratio comes from the contact's restitution coefficient ``e``
-  (unclipped linear dashpot: ``e = exp(-pi zeta / sqrt(1 - zeta^2))``), i.e.
-  ``zeta = -ln e / sqrt(pi^2 + ln^2 e)``, capped at 1 (critical damping) for e -> 0;
-  the contact lasts ``t_c = pi / (omega sqrt(1 - zeta^2))``, ``omega = sqrt(k_n / m_eff)``.
+* tangential spring with a Coulomb slider (Cundall & Strack 1979): ``xi += h U_t``,
+  ``f_t = -k_t xi - c_t U_t``; if ``|f_t| > mu f_n``, ``f_t = +-mu f_n`` and the spring
+  is reset to ``xi = -(f_t + c_t U_t) / k_t``;
+* ``zeta = -ln e / sqrt(pi^2 + ln^2 e)`` from the contact's restitution ``e`` (the
+  unclipped linear dashpot's), capped at 1 for e -> 0.
 
-Integration is symplectic Euler, ``u += h M^-1 F(q, u)``, ``q += h u``: stable for an
-undamped spring iff ``h omega < 2`` (:func:`critical_step` uses the issue's
-``omega = sqrt(k_n / m)`` with the smallest mobile mass; chains of springs and
-dashpots lower the limit).  Candidate pairs come from
-:func:`ncd.core.contacts.detect_contacts` with an alert distance ``skin``; the list is
-rebuilt (spring states carried by body-pair key) when a disc moved more than
-``skin / 2``.  Divergence (non-finite state or a speed above ``speed_limit``) stops
-the run and is reported with its step, never as inf/NaN values.
+Symplectic Euler, ``u += h M^-1 F(q, u)``, ``q += h u``, is stable for an undamped spring
+iff ``h omega < 2`` (:func:`critical_step`, with the smallest mobile mass; chains of
+springs and dashpots lower the limit).  Candidate pairs come from
+:func:`ncd.core.contacts.detect_contacts` with an alert distance ``skin``, rebuilt
+(spring states carried by body-pair key) when a disc moved more than ``skin / 2``.
+Divergence (non-finite state or a speed above ``speed_limit``) stops the run and is
+reported with its step, never as inf/NaN values.
 """
 from dataclasses import dataclass
 

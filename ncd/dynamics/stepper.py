@@ -205,10 +205,11 @@ def kinetic_energy(scene):
     return float(0.5 * np.sum(m * np.sum(scene.vel[:nm] ** 2, axis=1)) + 0.5 * np.sum(inertia * scene.spin[:nm] ** 2))
 
 
+# ------------------------------------------------------------ argument checks
 def check_step_problem(s, problem, name="problem", full=False):
     """A :class:`ncd.StepProblem` built for ``s`` (:func:`ncd.prepare_step`).  Without
     ``full``, only what :func:`ncd.solve_problem` reads before :func:`ncd.solve_discs`
-    checks the rest (contacts, W, bias: :func:`disc_problem`)."""
+    checks the rest (contacts, W, bias: :func:`ncd.solver.nlgs.check_disc_problem`)."""
     check_scene(s)
     if not isinstance(problem, StepProblem):
         raise InputError(f"{name} must be an ncd.StepProblem (from ncd.prepare_step); got {type(problem).__name__}")
@@ -248,7 +249,7 @@ def check_step_args(h, theta, gap_tolerance, vel=None, spin=None, n_disc=None):
 
 
 def check_step_call(s, h, theta=0.5, settings=None, init="zero", gap_tolerance=None, speed_limit=np.inf,
-              velocity_tol=0.0):
+                    velocity_tol=0.0):
     """Arguments of :func:`ncd.step` and :func:`ncd.equilibrium_test` known before
     the contacts are (``init``'s shape and ``review_order`` are checked once they are)."""
     check_scene(s)

@@ -2,8 +2,9 @@
 figure, each turning a config section into xarray Datasets.
 
 A figure's module imports only modules of its own figure (:data:`FIGURE_MODULES`) and
-the layers below; what two figures share lives in :mod:`ncd.scenes`.  The workflow
-reads the same table: a figure's computing rules depend on its own modules only.
+the layers below; what two figures share lives in :mod:`ncd.scenes`.  The workflow reads
+the same table: a figure's computing rules depend on the layers below and on its own
+modules, so that editing one figure reruns no other.
 """
 FIGURE_MODULES = {
     "fig1_wedged": ("wedged",),

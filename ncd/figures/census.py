@@ -1,31 +1,12 @@
 """Figure 2, exactly: a census of the solutions of the investigated step (Moreau 2005, section 3).
 
-NLGS from the zero guess reaches a few end points; that does not say how many
-solutions the step has.  The census gathers exact solutions from three sources,
-each polished on its contact statuses to a relative natural-map residual
-``<= polish_tol`` (:func:`ncd.solver.finish.project_statuses`, minimum-norm correction):
-
-* ``nlgs``: the distinct end points of the figure's ensemble (zero-guess and
-  warm-start runs at the tightest tolerance) and of ``random_runs`` NLGS runs
-  from random guesses;
-* ``lemke``: Lemke's method (:mod:`ncd.solver.lcp`) on the LCP form of the step (size
-  ``3 kappa``), with the covering vector ``1`` and ``lemke_runs - 1`` random ones,
-  log-uniform over ``± lemke_decades`` decades (each follows its own
-  complementary path);
-* ``enumeration``: the contacts whose status differs between any two solutions
-  found, grouped into clusters that share a grain; each cluster takes the
-  statuses of one solution or, when small, any combination of the statuses seen
-  at its contacts; all combinations up to ``max_patterns``, else every
-  single-cluster change of every solution plus seeded random combinations
-  (:func:`ncd.scenes.slope_analysis.status_patterns`).  Each pattern is solved on its statuses, polished
-  and kept when exact; repeated while new solutions appear
-  (:func:`enumerate_statuses`, at most ``enumeration_rounds``).
-
-Solutions are distinct when their acceleration fields differ by more than
-``same_tol |g|``.  Per solution: its basin (how many zero-guess, warm-start and
-random-guess runs end within ``basin_tol |g|`` of it) and its stability (NLGS
-restarted from it plus a relative perturbation ``noise``, ``perturb_runs`` times,
-returns to it within ``basin_tol``).
+NLGS from the zero guess reaches a few end points, which does not say how many solutions
+the step has.  The census gathers exact solutions (each polished on its contact statuses,
+:func:`ncd.solver.finish.project_statuses`) from three sources: the NLGS end points of the
+ensemble and of random guesses, Lemke's method (:mod:`ncd.solver.lcp`) with several
+covering vectors, and an enumeration of status patterns of the switching contacts
+(:func:`enumerate_statuses`, :func:`ncd.scenes.slope_analysis.status_patterns`).  Per
+solution: its basin (which runs end on it) and its stability under perturbation.
 """
 import time
 

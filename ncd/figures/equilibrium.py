@@ -1,16 +1,11 @@
 """Figure 3 of Moreau (2005), section 4: indetermination clouds of 28 discs at rest.
 
-A small container (floor and two side walls) is filled by depositing
-``n_discs`` polydisperse discs under gravity with Moreau-Jean steps
-(:func:`deposit`) until the one-step equilibrium test of section 2, warm
-started, finds ``u_f = 0``.  The core problem of one step from ``u_i = 0`` on
-that packing is then solved many times by NLGS (:func:`run_ensemble`), in the
-three exploration modes of section 2: zero guess with a random review order
-per run (the paper's figure), random initial guesses from a stated range, and
-the warm-start guess (the impulses of the last deposition step).  The exact
-projections of ``A ∩ C`` (:mod:`ncd.exact.polytope`) and a uniform sample of it
-(:func:`projection_dataset`, :func:`uniform_dataset`) are the references the
-clouds are measured against (:func:`cloud_measures`).
+Discs are deposited in a small box (:func:`deposit`) until the warm-started equilibrium
+test of section 2 finds ``u_f = 0``; the one-step problem from ``u_i = 0`` on that
+packing is then solved many times by NLGS in the three exploration modes of section 2
+(:func:`run_ensemble`: zero guess with random orders, random guesses, warm start).  The
+exact projections of ``A ∩ C`` (:mod:`ncd.exact.polytope`) and a uniform sample of it are
+the references the clouds are measured against (:func:`cloud_measures`).
 """
 from dataclasses import replace
 
@@ -60,12 +55,9 @@ def initial_packing(p):
 def deposit(cfg, progress=None):
     """Deposit the discs and step until they are at rest.
 
-    Every ``check_every`` steps the test of section 2 (one step from ``u_i = 0``,
-    NLGS warm-started from the last step's impulses) is run; deposition stops
-    when it finds ``u_f = 0`` (``velocity_tol``) and the discs themselves move
-    slower than ``speed_tol`` (both relative to ``|g| h``; a disc still rolling
-    over an equilibrium position would pass the test alone).  Returns ``(scene, info)``.
-    """
+    Every ``check_every`` steps the warm-started test of section 2 runs; deposition stops when
+    it finds ``u_f = 0`` and the discs themselves move slower than ``speed_tol`` (a disc still
+    rolling over an equilibrium position would pass the test alone).  Returns ``(scene, info)``."""
     p = cfg["packing"]
     pos, radius = initial_packing(p)
     scene = make_scene(pos, radius, p["density"], walls=container(p), gravity=p["gravity"], mu=p["mu"])

@@ -1,12 +1,10 @@
-"""Where NLGS solutions lie in A ∩ C, measured over every run (Moreau 2005, section 4).
+"""Where NLGS solutions lie in A ∩ C, over every run (Moreau 2005, section 4).
 
-For each equilibrium force vector ``r`` of a :class:`ncd.exact.polytope.ForcePolytope`:
-the dimension of the face of A ∩ C holding it (the Coulomb rows it satisfies
-with equality, within ``tol`` of the force scale), the contacts carrying no
-force (``r_n <= tol``) and the contacts sliding at the Coulomb limit
-(``|r_t| >= mu r_n - tol`` with ``r_n > tol``).  :func:`face_summary` counts them
-per exploration mode and :func:`face_text` states the result in words, so that
-the notebook's sentences follow from the measurement.
+For each equilibrium force vector of a :class:`ncd.exact.polytope.ForcePolytope`: the
+dimension of the face of A ∩ C holding it (Coulomb rows tight within ``tol``), the
+contacts carrying no force and those sliding at the Coulomb limit.  :func:`face_summary`
+counts them per exploration mode and :func:`face_text` words the result, so that the
+notebook's sentences follow from the measurement.
 """
 import numpy as np
 

@@ -1,28 +1,12 @@
-"""Figure 5 (issue 15): what governs indeterminacy — static packings across friction.
+"""Figure 5: what governs indeterminacy -- static packings across friction.
 
-Packings of ``n_discs`` rigid discs with radii uniform in ``[R, 2R]`` are built
-by contact dynamics at the friction ``mu`` they are analysed at, in two
-geometries (:data:`KINDS`):
-
-* ``plates`` — the setup of Unger, Kertész & Wolf (PRL 94, 178001, 2005): a
-  bottom plate, periodic sides of width ``width_radii * R`` (42 R), no
-  gravity.  The compression is a uniform body force of magnitude ``gravity``
-  toward the bottom plate (the second protocol of the brief); there is no lid.
-  A lid wall held fixed adds a self-stress (lid against plate) to ``A``, so
-  ``A ∩ C`` is unbounded unless the lid force is prescribed; with the body
-  force the load is prescribed on every grain and ``A ∩ C`` is bounded.  The
-  difference from Unger et al.: the confining stress grows with depth instead
-  of being uniform (measured ratios, η, do not depend on the load scale).
-* ``box`` — under gravity between two side walls, as in Figure 3
-  (:mod:`.equilibrium`), same radii and width.
-
-Start: a ballistic deposit (each disc, in a random order at a random x, is
-dropped vertically until it touches the plate or a disc already placed), so
-that the contact-dynamics relaxation starts close to the final height; then
-Moreau-Jean steps at ``mu`` until the warm equilibrium test of section 2 gives
-``u_f = 0`` and every disc moves slower than ``speed_tol |g| h``.
-Every packing draws from ``default_rng((member, root_seed))`` with
-``member = mu_index * per_mu + k`` (and a kind offset).
+Packings of discs with radii uniform in ``[R, 2R]`` are built by contact dynamics at the
+friction ``mu`` they are analysed at, in two geometries (:data:`KINDS`): ``plates``, the
+setup of Unger, Kertész & Wolf (PRL 94, 178001, 2005) with a body force toward the bottom
+plate instead of a lid (a fixed lid adds a self-stress that makes ``A ∩ C`` unbounded),
+and ``box``, under gravity between side walls as in Figure 3 (:mod:`ncd.figures.equilibrium`).
+A ballistic deposit starts the relaxation close to its final height; Moreau-Jean steps
+then run until the equilibrium test of section 2 passes and every disc is slow.
 """
 import numpy as np
 import xarray as xr
@@ -195,7 +179,7 @@ def scene_of(packings, j, cfg):
 
 
 def exact_shard(packings, cfg, progress=None):
-    """Exact measures (:func:`.governing_exact.exact_measures`) of every packing of a shard
+    """Exact measures (:func:`ncd.figures.governing_exact.exact_measures`) of every packing of a shard
     -> Dataset (dims packing, contact; per-contact arrays NaN-padded to the largest kappa)."""
     e = cfg["exact"]
     rows = []
@@ -248,15 +232,12 @@ def _no_shards(cfg):
 
 
 def unger_relax(scene, problem, cfg, rng, start=None):
-    """Unger et al.'s sampling: from a solution, add uniform noise of amplitude
-    ``noise * <|r|>`` to every contact force component and relax it again by NLGS
-    (random review order); ``rounds`` times, a random walk inside the solution set.
-    The starting solution is relaxed from ``start`` (the last build step's impulses).
-    NLGS is finished by the active-set stage (``unger.solver.finish``), so that a
-    relaxed point satisfies ``u_f = 0`` to round-off rather than to the tolerance.
-    Returns ``(forces (rounds + 1, kappa, 2), converged, at_rest)``: a round counts
-    only when NLGS converged and ``u_f = 0`` (the relaxed forces lie in A ∩ C).  When
-    the first relaxation fails, the later rounds are not run (NaN forces, flags False)."""
+    """Unger et al.'s sampling: a random walk inside the solution set, ``rounds`` steps.
+
+    Each round adds uniform noise (``noise * <|r|>``) to every force component and relaxes
+    by NLGS with a random order, finished by the active-set stage so that ``u_f = 0`` holds
+    to round-off.  Returns ``(forces, converged, at_rest)``; a round counts only when both
+    hold, and after a failed first relaxation the rest are NaN."""
     u, p = cfg["unger"], cfg["packings"]
     settings = SolverSettings(**u["solver"])
     h, g, nm = p["h"], p["gravity"], scene.n_mobile

@@ -1,31 +1,12 @@
-"""Exact measures of ``A ∩ C`` for the packings of figure 5 (Moreau 2005, section 4).
+"""Exact measures of ``A ∩ C`` for the packings of Figure 5 (Moreau 2005, section 4).
 
-Per packing (``H r + F = 0`` from :func:`ncd.core.contacts.h_matrix`, Coulomb sectors,
-scaled as in :class:`ncd.exact.polytope.ForcePolytope`):
-
-* ``rank H``, ``dim A = 2 kappa - rank H``;
-* the exact range ``[min, max]`` of every contact's normal and tangential force
-  over ``A ∩ C``: 4 kappa linear programs solved by HiGHS (``highspy``), one
-  model (Coulomb sectors as column bounds) whose objective alone changes, each
-  solve restarted from the basis of the best point known for its objective
-  (:func:`force_ranges`);
-* the implicit equalities of ``A ∩ C`` (Coulomb rows tight at every point: a
-  contact carrying no force, or forced to slide), found from the LP points and
-  confirmed one by one by LP; the *rank count*
-  ``dim (A ∩ C) = 2 kappa - rank [H; implicit rows]``;
-* the *LP dimension*: the affine rank of LP points of ``A ∩ C``, completed by
-  LPs along directions of the affine hull not yet spanned, until every such
-  direction is either spanned or found flat (:func:`lp_dimension`); it equals
-  the rank count when both are right, which the tests check on every packing;
-* contacts fixed by statics (both ranges of width ``<= width_tol * scale``);
-* boundedness: a self-stress inside ``C`` (e.g. an arch wedged between the box walls
-  at large friction) makes ``A ∩ C`` unbounded; its infinite ranges are ``±inf``
-  (NaN in the files) and ``eta_exact`` is NaN (the packing is reported, not averaged);
-* the exact indeterminacy ratio (defined here)
-  ``eta_exact = sum_alpha |(Δr_n, Δr_t)|_alpha / sum_alpha |r̄_alpha|``,
-  ``Δ`` the widths of the ranges and ``r̄`` the centre of the range box, i.e. the
-  mean over contacts of the diagonal of the bounding box of the contact's
-  projection over the mean force at the box centres.
+Per packing (``H r + F = 0``, Coulomb sectors, scaled as in
+:class:`ncd.exact.polytope.ForcePolytope`): ``rank H`` and ``dim A``; the exact range of
+every force component over ``A ∩ C`` by HiGHS LPs on one model (:func:`force_ranges`);
+the implicit equalities and ``dim (A ∩ C)`` by a rank count, checked against the affine
+rank of LP points (:func:`lp_dimension`); the contacts fixed by statics; boundedness (a
+self-stress inside ``C`` gives infinite ranges, reported as NaN); and the exact
+indeterminacy ratio ``eta_exact`` (range widths over the mean force at the range centres).
 """
 import highspy
 import numpy as np
@@ -35,13 +16,12 @@ from ncd.exact.polytope import ForcePolytope, PolytopeError
 
 
 class _Model:
-    """One HiGHS model of the scaled ``A ∩ C`` with the Coulomb sectors as column bounds
-    (:func:`ncd.exact.exact_set.cone_columns`: ``x = T y``, ``y >= 0``), so that its only rows are
-    the equilibrium equations ``A_eq x = b_eq``; queries take and return ``x`` (scaled
-    forces).  Only the objective changes between solves; :meth:`minimize` can restart
-    from a stored basis (``start``).  Measured on a 200-disc packing at mu = 0.01 (786
-    forces): the sectors as bounds instead of 3 kappa rows and the restart from the best
-    known point make the 4 kappa range LPs 2.5-3x faster than rows and last-basis restarts."""
+    """One HiGHS model of the scaled ``A ∩ C``, Coulomb sectors as column bounds
+    (:func:`ncd.exact.exact_set.cone_columns`), so its only rows are the equilibrium equations.
+
+    Queries take and return scaled forces ``x``; only the objective changes between solves,
+    and :meth:`minimize` can restart from a stored basis: bounds instead of rows, and a
+    restart from the best known point, make the range LPs much cheaper."""
 
     def __init__(self, P, feas_tol=1e-10):
         self.P = P

@@ -1,23 +1,12 @@
-"""Figure 5, items 2 and 3 of issue 15: the Figure 2 flow across friction, time step and slope.
+"""Figure 5: the Figure 2 flow across friction, time step and slope.
 
-The flow is Figure 2's (:mod:`.slope`: ``fig2_slope.scene`` and ``deposit``, discs on a
-rough periodic ground).  The design is one factor at a time around Figure 2's flow
-(``flows.base``: mu 0.5, h 5e-4 s, 24 deg): the extra values of ``flows.mu``,
-``flows.h`` and ``flows.slope_deg`` each change one parameter (:func:`settings_table`),
-``flows.seeds`` flows per setting.  Every setting of a seed is released from the same
-deposit (:func:`deposit_dataset`: under gravity normal to the ground, at the base's mu):
-a setting changes its one parameter at the release only, so the settings of a seed differ
-in that parameter and nothing else (deposits per mu took a tenth of the figure's time).
-
-Each flow is released (gravity tilted), stepped with warm starts for ``duration``
-seconds, and scanned at the same times ``scan_every, 2 scan_every, ...`` whatever h
-(:func:`scan_step`): ``runs`` zero-guess and ``runs`` warm-start NLGS runs with random
-review orders (tolerance ``tol``, Figure 2's scan), converged when the natural-map
-residual is below ``tol`` and the grain accelerations have stopped changing
-(:mod:`ncd.solver.convergence`); unconverged runs are counted and excluded.  Per scan: the
-distinct solutions of the converged runs (both inits pooled), the largest RMS spread of a
-grain's acceleration, and at every step with two solutions or more the measures of
-:mod:`.governing_line` (why a line).
+The flow is Figure 2's (:mod:`ncd.scenes.slope`).  The design is one factor at a time
+around Figure 2's settings (:func:`settings_table`); every setting of a seed is released
+from the same deposit (:func:`deposit_dataset`), so the settings of a seed differ in their
+one parameter only.  Each flow is scanned at the same times whatever ``h``
+(:func:`scan_step`) by zero-guess and warm-start NLGS runs; per scan, the distinct
+solutions of the converged runs, the largest spread of a grain's acceleration and, when
+there are several solutions, the measures of :mod:`ncd.figures.governing_line`.
 """
 import numpy as np
 import xarray as xr
@@ -187,9 +176,10 @@ def scan_step(scene, h, sc, members):
 
 
 def _exact_solutions(scene, problem, acc, imp, reps, spread, sc, g):
-    """Polish each distinct end point on its statuses (:class:`.census.StepSolutions`) to a
-    natural-map residual ``<= polish_tol``; the polished ones still distinct are exact
-    solutions (``n_exact``); with two or more, the measures of :mod:`.governing_line`."""
+    """Polish each distinct end point on its statuses
+    (:class:`ncd.scenes.step_solutions.StepSolutions`) to a natural-map residual ``<= polish_tol``;
+    the polished ones still distinct are exact solutions (``n_exact``); with two or more, the
+    measures of :mod:`ncd.figures.governing_line`."""
 
     st = StepSolutions(scene, problem)
     sols, status, failed = [], [], 0

@@ -1,27 +1,12 @@
-"""Figure 5, item 3 of issue 15: why the dispersion of a grain's acceleration is a line.
+"""Figure 5: why the dispersion of a grain's acceleration is a line.
 
-At a step whose converged NLGS runs reach several distinct solutions (acceleration
-fields further apart than a threshold), with the exact solutions ``s_k``
-(representatives polished on their statuses, :class:`ncd.scenes.step_solutions.StepSolutions`):
-
-* :func:`switched_contacts`: the contacts whose status (open, stick, slide forward,
-  slide backward) differs between the solutions;
-* :func:`status_dimension`: the dimension of the affine set of impulses keeping the
-  statuses of one solution (the most frequent), ``dim null K``, ``K = S^T W P`` (:func:`ncd.solver.finish.status_system`:
-  the velocity equations of its sticking and sliding contacts), and the dimension of
-  the grain velocities it spans, ``dim null K - dim null [K; H P]`` (an upper bound of
-  the local dimension of the solution set when an inequality is tight);
-* :func:`moving_clusters`: the grains whose acceleration differs between solutions and
-  the connected groups they form through the contacts active in either solution;
-* :func:`field_rank`: the number of independent directions of the solutions' acceleration
-  fields (rank of ``a_k - a_0`` over the whole field);
-* :func:`cloud_rank`: the rank of one grain's 2-D acceleration cloud (0 point, 1 line, 2).
-
-The hypothesis (Unger et al.'s elementary clusters; Moreau's remark on contacts with
-zero sliding velocity): *a grain's cloud is a line when one isolated one-degree-of-freedom
-cluster decides between the solutions*: the differing grains connected to that grain form
-a cluster over which the solutions span one direction (:func:`line_analysis`).  Two
-solutions always span one direction: the test has content from three solutions on.
+At a step whose converged NLGS runs reach several exact solutions
+(:class:`ncd.scenes.step_solutions.StepSolutions`): the contacts that switch status, the
+dimension of the set keeping one solution's statuses (:func:`status_dimension`), the
+clusters of grains that move differently, and the ranks of the acceleration field and of
+one grain's cloud.  The hypothesis tested (:func:`line_analysis`, after Unger et al.'s
+elementary clusters): a grain's cloud is a line when one isolated one-degree-of-freedom
+cluster decides between the solutions; it has content from three solutions on.
 """
 import numpy as np
 
@@ -97,16 +82,12 @@ def cloud_rank(ax, ay, threshold):
 
 
 def line_analysis(accel, status, body_a, body_b, cloud, grain, threshold, W=None, H=None, mu=None):
-    """Every measure of item 3 at one indeterminate step.
+    """Every measure of why a line, at one indeterminate step.
 
-    ``accel`` (S, n, 2): the distinct solutions (most frequent first); ``status`` (S, kappa);
-    ``cloud`` (runs, 2): the accelerations of grain ``grain`` over the converged runs;
-    ``threshold``: the solution threshold (acceleration units).  The hypothesis is read
-    for that grain: its cloud is predicted a line when its cluster (the connected group of
-    differing grains it belongs to) has one degree of freedom, i.e. the solutions
-    restricted to the cluster span one direction.  With ``W, H, mu``
-    (:func:`ncd.solver.finish.global_delassus`) the status dimensions of the first (most frequent)
-    solution are added (two dense SVDs of size ~2 kappa).  Returns a dict of numbers."""
+    ``accel`` (S, n, 2) the distinct solutions, most frequent first; ``status`` (S, kappa);
+    ``cloud`` (runs, 2) the accelerations of ``grain``.  The cloud is predicted a line when
+    the grain's cluster of differing grains has one degree of freedom.  With ``W, H, mu``
+    the status dimensions of the first solution are added.  Returns a dict of numbers."""
     accel, status = np.asarray(accel, float), np.asarray(status)
     switched = switched_contacts(status)
     active = (status > 0).any(axis=0)

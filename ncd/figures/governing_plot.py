@@ -1,5 +1,6 @@
-"""Panels of figure 5 (issue 15): eta(mu) exact and Unger et al.'s way, dimensions,
-coordination (packings); indeterminate flow steps against mu, h and slope, and why a line (flows)."""
+"""Panels of Figure 5: eta(mu) exact and Unger et al.'s way, dimensions, coordination
+(packings); indeterminate flow steps against mu, h and slope, and why a line (flows).
+"""
 import matplotlib.pyplot as plt
 import numpy as np
 

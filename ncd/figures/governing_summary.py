@@ -1,13 +1,9 @@
-"""Figure 5, items 2-3 of issue 15: the flow study's numbers (``flows.nc``) per parameter.
+"""Figure 5: the flow study's numbers (``flows.nc``) per parameter.
 
-* :func:`flow_measures`: per flow, the fraction of indeterminate scanned steps (over the
-  steps whose answer is known), the fraction unknown, the mean largest spread of a grain's
-  acceleration over the converged runs and the mean distance between exact solutions at
-  the indeterminate steps;
-* :func:`factor_table`: those per setting of one factor (the base included), mean and
-  95 % t-band over the seeds;
-* :func:`line_counts`: at every indeterminate step, the ranks of the clouds and how often
-  the cluster hypothesis holds (:mod:`.governing_line`).
+:func:`flow_measures` (per flow: fraction of indeterminate steps, mean spread, distance
+between solutions), :func:`factor_table` (per setting of one factor, with a 95 % t-band
+over seeds) and :func:`line_counts` (cloud ranks and how often the cluster hypothesis of
+:mod:`ncd.figures.governing_line` holds).
 """
 import numpy as np
 
@@ -55,15 +51,12 @@ def factor_table(ds, factor, measure):
 
 
 def line_counts(ds):
-    """Counts over the indeterminate steps of every flow: ``steps``, ``rank`` (cloud rank
-    0, 1, 2), ``predicted`` (cluster with one degree of freedom), ``holds`` (hypothesis
-    agrees with the cloud), ``line_and_predicted`` / ``line_not_predicted``,
-    ``solutions`` (number of exact solutions: 2, 3, more), ``continuum`` (a solution's
-    statuses leave grain velocities free: null_velocity > 0), ``one_cluster``; and
-    ``tested``: the same over the steps with three solutions or more, the only ones where
-    the hypothesis can fail (two solutions always span one direction): ``steps``,
-    ``holds``, ``line_and_predicted``, ``line_not_predicted``, ``predicted_not_line``,
-    ``neither`` (no line, none predicted)."""
+    """Counts over the indeterminate steps of every flow: cloud ranks, predictions and agreement.
+
+    ``predicted``: a cluster with one degree of freedom; ``holds``: the hypothesis agrees
+    with the cloud; also solution counts, ``continuum`` and ``one_cluster``.  ``tested``
+    repeats the counts over steps with three solutions or more, the only ones where the
+    hypothesis can fail (two solutions always span one direction)."""
     ind = ds.indeterminate.values == 1
     rank = ds.cloud_rank.values[ind]
     pred = ds.predicted_line.values[ind] == 1

@@ -1,26 +1,12 @@
-"""Piles of two construction histories (issue 16; Moreau 2005, section 5).
+"""Piles of two construction histories (Moreau 2005, section 5): a point source and a rain.
 
-Member ``m`` of history ``point`` or ``rain`` is built from independent
-generators ``default_rng((m, root_seed, stream))``:
-
-* stream 0: the rough ground (:func:`ncd.scenes.pile.make_ground`), the same for both histories;
-* stream 1: the grain radii, in order of insertion, the same for both histories;
-* stream 2 (point) or 3 (rain): the source (slot order and jitter, or rain positions).
-
-The rain falls uniformly over ``|x| <= width_fraction * L``, ``L`` the base
-half-width of the point-source pile of the same member (from its flank fits), so a
-rain pile's rule reads that pile's file.  As in the experiments (sand rained through
-a sieve onto a base of finite size: Vanel et al. 1999; Geng et al. 2001), the rain
-pile stands on a finite base: the member's ground discs with ``|x| <= L`` only.
-Grains that roll off its edges are removed from the simulation once their centre
-falls ``DROP_D`` mean diameters below the ground discs' centres
-(:func:`ncd.scenes.construction.build`), and the rain goes on, from the same
-sequence of radii (stream 1, continued past ``grains.n``), until ``grains.n`` grains
-stand on the base or ``rain.pour_limit * grains.n`` have been poured: the rain pile
-holds as many grains as the point pile (unless the limit stops it: ``n_grains`` and
-``n_removed`` say), its first ``grains.n`` poured grains are the point pile's.  Construction: :func:`ncd.scenes.construction.build`
-(checkpoints, frames); the final state, its history forces and the frames go to one
-netCDF file per pile.
+Member ``m`` of each history draws from independent generators
+``default_rng((m, root_seed, stream))``: the ground and the grain radii are the same for
+both histories, only the source differs.  As in the experiments (Vanel et al. 1999; Geng
+et al. 2001) the rain falls over the base half-width ``L`` of the member's point pile onto
+a finite base, grains rolling off it are removed and the rain goes on until the pile
+holds as many grains as the point pile.  Construction: :func:`ncd.scenes.construction.build`
+(checkpoints, frames); one netCDF file per pile.
 """
 import numpy as np
 import xarray as xr

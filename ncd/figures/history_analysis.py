@@ -1,31 +1,12 @@
-"""Ground pressure and arching over ensembles of piles of two histories (issue 16).
+"""Ground pressure and arching over ensembles of piles of two histories (Moreau 2005, section 5).
 
-Per pile (history forces: the warm-started equilibrium test of its final state):
-
-* ground stress profile ``p(xi)``, ``xi = x / L`` (``L`` the base half-width of the
-  member's point-source pile, :func:`norm_length`; ``x = 0`` the source axis): a
-  Gaussian kernel average of the vertical forces of the ground contacts, standard
-  deviation ``w`` mean diameters, normalised by the
-  mean ground stress ``W / (2 L)`` (``W`` the weight), so ``p = 1`` is the weight
-  spread evenly over the base;
-* dip depth ``(M - m) / M``: ``m`` the central minimum of ``p`` (``|xi| <= dip_center``),
-  ``M`` the mean of the largest ``p`` on either side within ``dip_flank``: > 0 a dip
-  under the apex, < 0 a hump;
-* arching: the resultant across vertical cuts at ``x = ± q L`` (whole column,
-  :func:`ncd.scenes.cuts.cut_matrix`), its angle below the horizontal and its
-  deviation from the pile's own flank slope (:func:`ncd.scenes.cuts.flank_angles`);
-  a cut crossing no contact (near a toe) has no resultant direction: NaN, left out of
-  the statistics over piles (its count is ``cut_count``).
-
-Ensemble statistics resample *piles* (never runs of one pile): the mean profile with
-a percentile bootstrap band, the dip of the mean profile with its band, the
-difference of the histories with a bootstrap band and a permutation p-value
-(history labels shuffled among the piles).  The dip is a minimum against maxima of
-the mean profile, so its bootstrap distribution is biased upwards (a resampled mean
-profile is noisier: measured on the default run, the rain dip at 1 d, 0.185, lay
-outside its own percentile band [0.210, 0.377]); its bands, and those of the
-difference, are *basic* (reverse-percentile) bootstrap bands
-``[2 t - q_hi, 2 t - q_lo]`` (:func:`basic_band`), which correct that bias to first order.
+Per pile, from its history forces: the ground stress profile ``p(x / L)`` (kernel
+average of the ground contacts, normalised by the mean stress ``W / (2 L)``), the dip
+depth ``(M - m) / M`` (> 0 a dip under the apex) and the angle of the resultant across
+vertical cuts at ``x = ± q L`` against the pile's flank slope.  Statistics resample piles,
+never runs of one pile.  The dip is a minimum against maxima of a noisier resampled
+profile, so its percentile band is biased upwards; the dip and difference bands are
+therefore *basic* bootstrap bands (:func:`basic_band`), correct to first order.
 """
 import warnings
 

@@ -1,13 +1,10 @@
-"""Exact angle ranges at the arching cuts of a pile of fig4_history (issue 16, item 3).
+"""Exact angle ranges at the arching cuts of a pile of fig4_history (Moreau 2005, sections 4-5).
 
-For one pile file, over the set A ∩ C of its final configuration (every force state
-that balances the weights within the Coulomb cones, :class:`ncd.exact.exact_set.ExactSet`,
-HiGHS LPs), the exact range of the angle below the horizontal of the resultant across
-each arching cut of :func:`ncd.figures.history_analysis.pile_measures` (``x = ± q L``,
-whole column): a linear-fractional program, solved by Dinkelbach's iteration with a
-certified error bound (``angle_bound``), hence the range of its deviation from the
-pile's flank slope.  The history forces' angle lies in that range (checked:
-``history_outside``).
+Over ``A ∩ C`` of one pile's final configuration (:class:`ncd.exact.exact_set.ExactSet`),
+the exact range of the angle of the resultant across each cut of
+:func:`ncd.figures.history_analysis.pile_measures`: a linear-fractional program, solved
+by Dinkelbach's iteration with a certified error bound.  The history forces' angle must
+lie in that range (``history_outside`` counts the exceptions).
 """
 import time
 

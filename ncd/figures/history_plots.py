@@ -1,4 +1,5 @@
-"""Plots and prose numbers of fig4_history (issue 16): ground stress, dip, arching."""
+"""Plots and prose numbers of fig4_history: ground stress, dip, arching.
+"""
 import matplotlib.pyplot as plt
 import numpy as np
 

@@ -1,20 +1,11 @@
-"""How the piles of fig4_history change with size (issue 16, item 4).
+"""How the piles of fig4_history change with size.
 
-The analyses of several pile sizes (``analysis_n<n>.nc`` of :mod:`.history_analysis`,
-one per grain count) side by side, per history:
-
-* the dip depth of the mean ground-stress profile with its bootstrap band over piles
-  (copied from each analysis), and its change from the smallest size with a permutation
-  p-value (size labels shuffled among the piles of both sizes, the dip of each mean
-  profile recomputed: :func:`.history_analysis.permutation_p`);
-* the arching: per pile, the median over both flanks and every cut position of the cut
-  deviation (resultant angle minus the pile's flank slope); its mean over piles with a
-  bootstrap band, and its change from the smallest size with a permutation p-value;
-* the median deviation per cut position (copied), the flank slope, the apex height over
-  the base half-width and the cone ratio (means over piles).
-
-The abscissae ``x / L`` and cut positions ``|x| / L`` are the same at every size, so the
-profiles compare directly.  Every band resamples piles, never runs of one pile.
+The analyses of several pile sizes (``analysis_n<n>.nc`` of
+:mod:`ncd.figures.history_analysis`) side by side, per history: the dip depth and the
+median cut deviation with bootstrap bands over piles, and their change from the
+smallest size with a permutation p-value
+(:func:`ncd.figures.history_analysis.permutation_p`).  The abscissae are in units of the
+base half-width, so profiles of every size compare directly.
 """
 import numpy as np
 import xarray as xr

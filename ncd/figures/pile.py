@@ -1,14 +1,10 @@
 """Figure 4 (Moreau 2005, section 5): a 2-D pile poured from a localized source.
 
-Polydisperse discs are poured from a source above the middle of a rough
-horizontal ground (a row of fixed discs) and the whole construction is
-simulated with warm-started NLGS (the antecedent impulses as initial guess,
-section 2) until the equilibrium test of section 2 passes.  The final
-arrangement is then explored by NLGS runs from the zero guess with random
-review orders (section 5); the measures of :mod:`ncd.scenes.cuts` (cut
-resultants, ground pressure) are kept per run, with the run's outcome
-(:func:`ncd.solver.convergence.classify`: converged at rest, converged in motion, or not;
-the observable is the default cut resultant and the binned ground pressure).
+The pile is built by :func:`ncd.scenes.pile.construct` (warm-started NLGS until the
+equilibrium test of section 2 passes).  Its final arrangement is then explored by NLGS
+runs from the zero guess with random review orders (section 5), keeping per run the
+measures of :mod:`ncd.scenes.cuts` (cut resultants, ground pressure) and the run's
+outcome (:func:`ncd.solver.convergence.classify`: converged at rest, in motion, or not).
 """
 
 import numpy as np
@@ -105,14 +101,12 @@ def _observable(cfg, scene, contacts, C, edges):
 
 
 def ensemble_shard(cfg, construction, cuts, members, tolerances, root_seed, log=None, finish=None):
-    """NLGS runs from the zero guess with random review orders on the final state
-    (section 5), one set per tolerance; per run the cut resultants, the ground force
-    (total and per bin), the end-of-step velocities' summary and the solver record.
+    """NLGS runs from the zero guess with random orders on the final state (section 5), one
+    set per tolerance: cut resultants, ground force, velocity summary and solver record per run.
 
-    ``finish`` (default ``cfg["ensemble"]["finish"]``): "active_set" hands each run over
-    at ``tol`` to the finishing stage (:mod:`ncd.solver.finish`, to ``finish_tol``), an exact
-    solution whose observable has nothing left to settle, so the observable is not
-    tracked; "none": plain NLGS, converged only when the observable has settled too."""
+    ``finish="active_set"`` hands each run over at ``tol`` to :mod:`ncd.solver.finish`, an
+    exact solution whose observable needs no tracking; ``"none"``: plain NLGS, converged
+    only when the observable has settled too."""
     e = cfg["ensemble"]
     h, g = cfg["h"], cfg["gravity"]
     scene = final_scene(cfg, construction)

@@ -1,20 +1,11 @@
 """Figure 4, exactly: the set A ∩ C of the pile's final configuration (Moreau 2005, sections 4-5).
 
-The equilibrium forces of the final arrangement form the polytope
-``A ∩ C = {r : H r + F = 0, |r_t| <= mu r_n}``.  Every quantity of the figure is a
-linear map of ``r`` (cut resultants, ground forces), so its exact range over A ∩ C
-is given by linear programs on one warm-started HiGHS model
-(:class:`ncd.exact.exact_set.ExactSet`).  :func:`exact_dataset` writes ``exact.nc``:
-
-* (a) the exact polygon of the cut resultant (:meth:`ExactSet.polygon`) for the
-  default cut and the cuts moved by ``± shift_d``;
-* (b) for every cut of both flanks the exact range of the resultant's angle below the
-  horizontal (:meth:`ExactSet.angle_range`, a linear-fractional program: a few LPs,
-  certified, no polygon needed) and of its vertical component (a state *arches*
-  across a cut when the inner side pushes the bank downward, ``F_y < 0``: every
-  admissible state arches iff ``max F_y < 0``);
-* (c) the exact range of the ground pressure (:mod:`ncd.scenes.pressure`) and the
-  dip verdict.
+Every quantity of the figure is a linear map of the forces ``r`` (cut resultants, ground
+forces), so its exact range over ``A ∩ C = {r : H r + F = 0, |r_t| <= mu r_n}`` is given by
+LPs on one warm-started HiGHS model (:class:`ncd.exact.exact_set.ExactSet`).
+:func:`exact_dataset` writes ``exact.nc``: (a) the exact polygon of the cut resultant, (b)
+per cut the range of its angle and of its vertical component (every admissible state
+arches iff ``max F_y < 0``), (c) the range of the ground pressure and the dip verdict.
 """
 import time
 

@@ -1,28 +1,11 @@
 """Figure 1 of Moreau (2005), section 1: a disc B wedged between two fixed discs.
 
-Geometry (symmetric): B (radius ``R``, centre at the origin) touches two fixed
-discs (radius ``r``) whose centres ``(-/+ (R + r) cos beta, (R + r) sin beta)``
-lie above B's centre.  Contact 0 is the left obstacle, contact 1 the right one;
-their normals (from obstacle to B) point downward-inward, ``beta`` below the
-horizontal: ``n_0 = (cos b, -sin b)``, ``n_1 = (-cos b, -sin b)``, tangents
-``t = (-n_y, n_x)``.  Released at rest, B may fall freely (zero forces: the free
-velocity ``h g`` separates both contacts) or stay wedged.
-
-Closed form (notebook ``fig1_wedged``, "derivation"): moments about B's centre
-give ``T_0 = -T_1 = T``, horizontal forces ``N_0 = N_1 = N``, vertical forces
-``2 (T cos b - N sin b) = m g``; Coulomb ``T <= mu N`` then reads
-
-    N >= N_min = m g cos(gamma) / (2 sin(gamma - beta)),   gamma = atan(mu),
-
-so wedging is possible iff ``gamma > beta``.  The lines of action of the two
-forces meet at ``I = (0, y_I)`` with
-
-    y_I(N) = R sin b + R cos^2 b (m g / 2) / (N + (m g / 2) sin b),
-
-decreasing from ``y_top = R sin(gamma) / cos(gamma - beta)`` (reached, at
-``N = N_min``: both contacts at the edge of their cones) towards
-``y_bottom = R sin(beta)`` (reached only in the limit ``N -> inf``, where the two
-forces become horizontal and collinear).
+B (radius ``R``) touches two fixed discs (radius ``r``) whose centres lie ``beta`` above
+the horizontal through B's centre.  Released at rest, B may fall freely or stay wedged.
+Closed form (notebook ``fig1_wedged``): Coulomb ``T <= mu N`` gives
+``N >= N_min = m g cos(gamma) / (2 sin(gamma - beta))``, ``gamma = atan(mu)``, so wedging
+is possible iff ``gamma > beta``; the lines of action meet at ``(0, y_I(N))``, from
+``y_top = R sin(gamma) / cos(gamma - beta)`` at ``N_min`` down towards ``R sin(beta)``.
 """
 import time
 from dataclasses import dataclass

@@ -1,13 +1,9 @@
 """What a figure's notebook needs around the science: its inputs and outputs, wherever it runs.
 
 Under Snakemake's ``notebook:`` directive the injected ``snakemake`` object names the
-files.  Run by hand (from the repository root, from ``notebooks/`` or from anywhere
-inside the checkout), :func:`paths` finds the repository root and names the files a
-finished ``snakemake -j2 <figure>`` left under ``results/``: inputs
-``results/<data_dir>/<name>.nc``, outputs ``results/figures/<figure>.png|pdf``, and the
-figure's section of ``config.yaml``.  A notebook therefore writes only under ``results/``.
-
-Each notebook is a jupytext pair; :func:`check_pair` stops a run whose ``.py`` was
+files; run by hand from anywhere in the checkout, :func:`paths` finds the repository root
+and names what a finished ``snakemake -j2 <figure>`` left under ``results/``, so a
+notebook writes only there.  :func:`check_pair` stops a run whose jupytext ``.py`` was
 edited without ``jupytext --sync`` (the ``.ipynb`` that Snakemake runs would be stale).
 """
 from pathlib import Path

@@ -1,14 +1,10 @@
 """An executed notebook as a clean, offline HTML page (``rule render_html``).
 
-- Snakemake's injected preamble cell (a pickled object with the paths of the machine
-  that ran it) is dropped.
-- Code is hidden; one button shows it (the code stays in the page).
-- A long table (more than :data:`LONG_TABLE` rows) sits in a collapsed ``<details>``
-  block with its row count and horizontal scroll.
-- Maths is typeset by MathJax 2 from ``mathjax/`` beside the page (copied by
-  :func:`copy_mathjax` from the ``jupyter-server-mathjax`` package, whose bundle has
-  the STIX-Web fonts only): no network.  The body gets ``data-mathjax="done"`` once
-  typeset.
+Snakemake's injected preamble cell (a pickled object with the paths of the machine that
+ran it) is dropped; code is hidden behind one button; a table longer than
+:data:`LONG_TABLE` rows is folded in a ``<details>`` block; maths is typeset by MathJax 2
+from ``mathjax/`` beside the page (:func:`copy_mathjax`, from ``jupyter-server-mathjax``):
+no network.  The body gets ``data-mathjax="done"`` once typeset.
 """
 import re
 import shutil

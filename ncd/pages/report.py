@@ -264,7 +264,7 @@ def fig4_history_arching(results):
                     REPRODUCED if abs(med) <= 10 else DIFFERS, "median deviation within 10° of the free surface")
 
 
-# --- figure 5 (beyond the paper: issue 15) -------------------------------------------------------
+# --- figure 5 (beyond the paper) ----------------------------------------------------------------
 
 def fig5_governing_flows(results):
     flows = _open(results, "fig5_governing/flows.nc")

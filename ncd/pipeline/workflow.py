@@ -1,4 +1,4 @@
-"""Glue between Snakemake scripts and ncd: logging, threads, progress, settings.
+"""Glue between Snakemake scripts and ncd: logging, threads, progress, settings, recovery.
 
 Scripts under ``workflow/scripts`` stay thin: ``log = start(snakemake)``, read the
 config section from ``snakemake.params.config``, call the figure module, write

@@ -1,26 +1,11 @@
 """The construction loop of a pile (Moreau 2005, section 5), with checkpoints and frames.
 
-Grains from a source (:mod:`ncd.scenes.sources`) are added every
-``source.insert_every`` steps; every step is a warm-started Moreau-Jean step
-(the antecedent impulses as initial guess, section 2); once every grain is in,
-the equilibrium test of section 2 is tried every ``rest_check_every`` steps.
-
-Checkpoint (issue 16): every ``checkpoint_every`` steps the whole state of the
-loop -- scene state (positions, angles, velocities, spins, time), the warm-start
-memory (previous contact keys and impulses), the step counter, the grains' birth
-steps, the source's height, grain counter and generator state, the per-step
-record and the stored frames -- goes to an ``.npz`` written to a temporary file
-and renamed (atomic).  A run started with an existing checkpoint of the same
-configuration resumes after its step, and ends bit for bit where an
-uninterrupted run ends.
-
-Finite base (issue 16, raining): with ``drop_below`` set, a grain whose centre falls
-below that height (it has rolled off the edge of a finite ground) is removed from
-the simulation -- the scene is rebuilt without it and the warm-start memory of the
-remaining contacts is carried over (:func:`carry_warm`) -- and recorded in
-``info["removed"]``.  The source then pours until ``grains.n`` grains stand on the
-base or ``pour_limit`` grains have been poured (the rain of the experiments runs
-until the heap is complete, the excess falling off the base).
+Grains from a source (:mod:`ncd.scenes.sources`) are added every ``insert_every`` steps
+of warm-started Moreau-Jean steps (section 2); once all are in, the equilibrium test of
+section 2 decides when the pile is at rest.  A checkpoint (``.npz``, written atomically)
+holds the whole loop state, so that a resumed run ends bit for bit where an
+uninterrupted one ends.  With ``drop_below`` (a finite base, as for the rain) grains
+that roll off the base are removed and the pouring goes on until the pile is complete.
 """
 import json
 import os
@@ -118,18 +103,10 @@ def build(cfg, ground, source, scene_factory, log=None, log_every=10.0, checkpoi
           checkpoint_every=0, frame_every=0, drop_below=None, info=None, pour_limit=None):
     """Pour ``grains.n`` discs from ``source`` onto ``ground`` and step until at rest.
 
-    ``scene_factory(pos, radius, vel, spin, angle)`` builds a scene.  Returns
-    ``(scene, record, eq, frames)``: the final scene, the per-step record (dict of
-    arrays), the warm-started :class:`ncd.EquilibriumResult` of the final state
-    and ``(frame_steps, frames)`` with ``frames`` of shape (frame, 6, n) holding
-    :data:`FRAME` every ``frame_every`` steps (none if 0) and at the end.
-    ``checkpoint`` (a path) with ``checkpoint_every > 0`` saves and resumes.
-    ``drop_below`` (m): grains whose centre falls below it are removed (finite base);
-    pouring stops when ``grains.n`` grains are in the scene or ``pour_limit`` (default
-    ``grains.n``) grains have been poured;
-    ``info`` (a dict) receives ``order`` (insertion index of each final grain) and
-    ``removed`` (rows ``step, insertion index, x, y`` of the removed grains).
-    """
+    Returns ``(scene, record, eq, (frame_steps, frames))``: final scene, per-step record, the
+    warm-started :class:`ncd.EquilibriumResult` and :data:`FRAME` every ``frame_every`` steps.
+    ``checkpoint`` saves and resumes; ``drop_below`` removes grains off a finite base (pouring
+    until ``grains.n`` stand or ``pour_limit`` are poured); ``info`` gets ``order``, ``removed``."""
     c = cfg["construction"]
     d = mean_diameter(cfg)
     h = cfg["h"]

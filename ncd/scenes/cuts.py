@@ -1,22 +1,13 @@
 """Measures on a granular pile (Moreau 2005, section 5): free surface, cut resultants, ground pressure.
 
-All measures are linear in the contact impulses, so each is a sparse matrix
-``C`` with ``measure = C @ s.ravel() / h`` (``s`` the (n, 2) impulses
-``(s_n, s_t)``, ``h`` the time step): one matrix serves the history solution
-and every member of an ensemble.
-
-Cut resultant (section 5).  A vertical cut at ``x = x_cut`` separates an
-*inner* side (towards the pile axis) from an *outer* side (the bank).  The
-resultant across the cut is the sum of the forces exerted by the grains with
-centres on the inner side upon the grains with centres on the outer side,
-over the grain-grain contacts whose line of centres crosses the cut within the
-segment ``y_lo <= y <= y_hi``.  Contacts with the ground (fixed discs) are
-ground reactions and never cross a cut.  A centre exactly on the cut counts
-as being on the side ``x >= x_cut``.
-
-Convention of :mod:`ncd.core.contacts`: contact ``alpha`` acts on its mobile disc
-``a`` with the force ``(s_n n + s_t t) / h``, ``n`` from ``b`` to ``a``,
-``t = (-n_y, n_x)``; ``b`` receives the opposite force.
+Every measure is linear in the contact impulses, a sparse matrix ``C`` with
+``measure = C @ s.ravel() / h``, so one matrix serves the history solution, every
+member of an ensemble and the exact LPs.  The resultant across a vertical cut at
+``x_cut`` is the force of the grains with centres on the inner side (towards the axis)
+on those of the outer side, over the grain-grain contacts whose line of centres crosses
+the cut within ``[y_lo, y_hi]`` (a centre on the cut counts as ``x >= x_cut``).  Signs
+follow :mod:`ncd.core.contacts`: contact ``alpha`` pushes its mobile disc ``a`` with
+``(s_n n + s_t t) / h``, ``n`` from ``b`` to ``a``, ``t = (-n_y, n_x)``.
 """
 import numpy as np
 import scipy.sparse as sp
@@ -125,12 +116,9 @@ def surface_profile(pos, radius, edges):
 def fit_flanks(x, height, x_axis, fit_range):
     """Straight-line fits ``height = c0 + c1 x`` of the two flanks of the profile.
 
-    A flank is fitted on the profile points on its side of the apex whose
-    height lies within ``fit_range`` (fractions of the apex height); returns
-    per flank (left, right) the slope angle in degrees (positive: height
-    decreasing away from the apex), ``c0, c1``, the toe (where the fitted line
-    meets height 0), the rms deviation and the number of points.
-    """
+    Each flank is fitted on its side of the apex, on the points whose height lies within
+    ``fit_range`` of the apex height; per flank (left, right): slope angle in degrees
+    (positive: falling away from the apex), ``c0, c1``, toe, rms deviation, point count."""
     ok = np.isfinite(height)
     top = np.nanmax(height)
     out = {}

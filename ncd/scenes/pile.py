@@ -49,16 +49,12 @@ def pile_scene(cfg, pos, radius, ground_pos, ground_radius, vel=None, spin=None,
 
 
 def construct(cfg, log=None, log_every=10.0, checkpoint=None, checkpoint_every=0, frame_every=0):
-    """Pour ``grains.n`` discs from the localized source and step until at rest
-    (section 2's equilibrium test); :func:`ncd.scenes.construction.build` is the loop.
+    """Pour ``grains.n`` discs from the localized source and step until at rest (the loop is
+    :func:`ncd.scenes.construction.build`).
 
-    Returns ``(scene, record, ground, eq)``: the final scene, the per-step record
-    (dict of arrays), the ground discs ``(pos, radius)`` and the warm-started
-    :class:`ncd.EquilibriumResult` of the final state (the history forces); with
-    ``frame_every > 0`` also the frames ``(frame_steps, frames)``.
-    Raises :class:`SimulationError` if a grain leaves the ground or if the pile is not
-    at rest after ``max_steps``.  Progress goes to ``log`` every ``log_every`` seconds.
-    """
+    Returns ``(scene, record, ground, eq)`` (``eq``: the warm-started equilibrium test of the
+    final state, i.e. the history forces), plus ``(frame_steps, frames)`` if ``frame_every > 0``.
+    Raises :class:`SimulationError` if a grain leaves the ground or the pile is not at rest."""
     rng = member_rng(0, cfg["seed"])
     ground = make_ground(cfg, rng)
     source = Source(cfg, rng, float(np.mean(ground[1])))

@@ -1,22 +1,11 @@
-"""Ground pressure of figure 4 from the ground contacts themselves (Moreau 2005, section 5).
+"""Ground pressure of Figure 4 from the ground contacts themselves (Moreau 2005, section 5).
 
-The ground pressure is the vertical force of the ground contacts per unit
-length.  Bins of fixed width hold a handful of contacts each, so a "dip" under
-the apex can come from where the edges fall.  Here every estimate is a linear
-map of the contact forces (a sparse row per abscissa), so that the same maps
-serve NLGS runs and the exact LP ranges of :mod:`ncd.figures.pile_exact`:
-
-* :func:`kernel_matrix`: a Gaussian kernel average ``p(x) = sum_c F_y,c
-  K_w(x - x_c)`` of the per-contact vertical forces (``w`` the stated standard
-  deviation, ``K_w`` normalized, in N/m);
-* :func:`bin_matrix`: histogram bins of width ``b`` shifted by ``s``;
-* :func:`dip_row`: the dip depth ``p(0) - (p(-a) + p(a)) / 2`` of one estimate
-  (negative: a dip under the apex ``x = 0``);
-* :func:`dip_verdict`: a dip is called only when the history's depth is
-  negative by more than both the binning sensitivity (the spread of the depth
-  over kernel widths and bin widths/shifts) and when the exact range of the
-  depth over A ∩ C lies below zero ("forced"); "allowed" when that range
-  contains zero, "excluded" when it lies above.
+Bins of fixed width hold a handful of contacts each, so a "dip" under the apex can come
+from where the bin edges fall.  Every estimate here (Gaussian kernel average
+:func:`kernel_matrix`, shifted bins :func:`bin_matrix`, dip depth :func:`dip_row`) is
+instead a linear map of the contact forces, so that the same rows serve NLGS runs and
+the exact LP ranges of :mod:`ncd.figures.pile_exact`.  :func:`dip_verdict` calls a dip
+only when it exceeds the binning sensitivity and its exact range over A ∩ C is below zero.
 """
 import numpy as np
 import scipy.sparse as sp

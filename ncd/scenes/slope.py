@@ -1,23 +1,13 @@
 """Figure 2 of Moreau (2005), section 3: a grain's acceleration in a flow down a slope.
 
-``n_discs`` polydisperse discs (diameters uniform in ``[d_min, d_max]``,
-``d_max / d_min = size_ratio``, mean ``diameter``) lie on a rough ground, a
-row of touching glued discs of the mean diameter along ``y = 0``, in a cell
-periodic along the ground (``width_diameters`` mean diameters wide).  They
-are deposited under gravity normal to the ground (:func:`deposit`), then
-released: gravity is tilted to ``slope_deg`` (the ground slopes down to the
-right, +x), friction ``mu``, restitution ``e``.  The flow is stepped with warm
-starts (:func:`flow`); the state before flow step ``step``, with the
-impulses of the step before it, is stored (:func:`trajectory_dataset`).
-
-The core problem of that step is then solved many times by NLGS with a
-random review order per run (:func:`run_ensemble`), from the zero guess and
-from the previous step's impulses (section 2).  Every run is continued from
-tolerance to tolerance (natural-map residual, decades), so that one run
-gives its acceleration ``(u_f - u_i) / h`` at every tolerance: the spread of
-the clouds against the tolerance separates a true indeterminacy (a fixed
-non-zero spread) from the iteration error of runs stopped early (a spread
-shrinking with the tolerance).  The measures are in :mod:`.slope_analysis`.
+Polydisperse discs on a rough periodic ground are deposited under gravity normal to the
+ground (:func:`deposit`), released down the slope and stepped with warm starts
+(:func:`flow`).  The core problem of the investigated step is solved many times by NLGS
+with random review orders, from the zero guess and from the previous impulses
+(:func:`run_ensemble`, section 2).  Each run goes on from tolerance to tolerance, so that
+the spread of the clouds against the tolerance tells a true indeterminacy (a fixed spread)
+from the iteration error of runs stopped early (a shrinking one); the measures are in
+:mod:`ncd.scenes.slope_analysis`.
 """
 import time
 
@@ -52,12 +42,9 @@ def gravity_vector(p, tilted=True):
 def geometry(p):
     """Radii, initial centres, ground discs and period of the scene.
 
-    Diameters uniform in ``[d_min, size_ratio d_min]`` with mean ``diameter``;
-    centres on a loose grid of cells ``(1 + gap) d_max`` wide (rows filled
-    left to right, x jitter within the cell) starting just above the ground,
-    which is a row of touching fixed discs of the mean diameter centred on
-    ``y = 0`` (``width_diameters`` of them across the period).
-    """
+    Diameters uniform in ``[d_min, size_ratio d_min]`` (mean ``diameter``), centres on a
+    loose grid just above the ground, a row of touching fixed discs of the mean diameter
+    on ``y = 0`` across the period."""
     rng = np.random.default_rng(p["seed"])
     n, d = p["n_discs"], p["diameter"]
     d_min = 2.0 * d / (1.0 + p["size_ratio"])
@@ -121,13 +108,11 @@ def snapshot(scene):
 
 
 def scan_step(scene, h, sc):
-    """A small exploration of the next step: ``sc["runs"]`` zero-guess and as many
-    warm-start runs (random orders, tolerance ``sc["tol"]``).  Returns per init,
-    over the *converged* runs only, the number of distinct solutions
-    (acceleration fields within ``sc["threshold"] |g|``), the largest spread over
-    the grains and the number of grains whose spread exceeds ``sc["visible"] |g|``;
-    the number of converged runs (0: nothing is known of that step) and the
-    median sweeps of all runs."""
+    """A small exploration of the next step: ``sc["runs"]`` zero-guess and as many warm-start runs.
+
+    Per init, over the converged runs only: distinct solutions (fields within
+    ``sc["threshold"] |g|``), the largest grain spread and the grains spreading more than
+    ``sc["visible"] |g|``; also the converged count (0: nothing known) and median sweeps."""
     problem = prepare_step(scene, h)
     settings = SolverSettings(tol=sc["tol"], max_sweeps=sc["max_sweeps"], check_every=sc["check_every"])
     g = float(np.hypot(*scene.gravity))
@@ -150,13 +135,10 @@ def scan_step(scene, h, sc):
 def flow(scene, cfg, progress=None, frames=None):
     """Release (tilt gravity) and step the flow ``flow.n_steps`` steps with warm starts.
 
-    Returns ``(series, state, reference, scan)``: per-step records, the
-    snapshot before step ``flow.step``, the accelerations of that step as the
-    trajectory computed them (warm start, identity review order) and, every
-    ``scan.every`` steps, a small exploration of the step (:func:`scan_step`).
-    With a list ``frames``, every ``flow.snapshot_every`` steps (0: none) a
-    :func:`frame_state` is appended to it, as ``(step, frame)``.
-    """
+    Returns ``(series, state, reference, scan)``: per-step records, the snapshot before step
+    ``flow.step``, that step's accelerations as the trajectory computed them, and every
+    ``scan.every`` steps a :func:`scan_step`.  A list ``frames`` receives ``(step, frame)``
+    every ``flow.snapshot_every`` steps."""
     fp, sc = cfg["flow"], cfg["scan"]
     scan = {k: [] for k in ("scan_step", *(f"{i}_{q}" for i in INITS
                                           for q in SCAN_FIELDS))}

@@ -1,27 +1,12 @@
-"""Measures of the acceleration clouds of figure 2 (Moreau 2005, section 3).
+"""Measures of the acceleration clouds of Figure 2 (Moreau 2005, section 3).
 
-* :func:`cloud_stats`: mean, covariance and principal axes of 2-D clouds
-  (vectorized over any leading dimensions), the line-likeness
-  ``minor / major`` (square roots of the covariance eigenvalues);
-* :func:`solutions`: the distinct solutions reached by an ensemble (runs whose
-  whole acceleration fields agree within a threshold);
-* :func:`verdict`: true indeterminacy or iteration error, from the spread of
-  the chosen grain against the tolerance;
-* :func:`contact_relation` (the paper's question of why the dispersion is a
-  line): the contacts whose status differs between the two most frequent
-  solutions, the networks of grains joined by contacts sticking in both
-  (:func:`rigid_clusters`), the best rigid motion of each network fitted to
-  the difference of the solutions (:func:`cluster_motion_fit`; sticking
-  grains may still roll on each other, so the fit measures how far from
-  rigid the difference is) and the number of sticking links from every grain
-  to the nearest switching contact;
-* :func:`cloud_against_census`: the chosen grain's cloud read through the
-  census of exact solutions (``census.nc``): which solutions its runs sit on,
-  and the iteration error left;
-* :func:`status_patterns` (for the census, :mod:`ncd.figures.census`): status
-  patterns combining the changes seen between several solutions, cluster by
-  cluster of switching contacts (:func:`contact_clusters`);
-* :func:`measures_dataset`: all of it as one Dataset (``measures.nc``).
+:func:`cloud_stats` (mean, covariance, principal axes, line-likeness), :func:`solutions`
+(distinct end points), :func:`verdict` (true indeterminacy or iteration error, from the
+spread against the tolerance), :func:`contact_relation` (the paper's question of why the
+dispersion is a line: switching contacts, sticking clusters and their rigid-motion fit),
+:func:`cloud_against_census` (the cloud read through the exact solutions of
+:mod:`ncd.figures.census`), :func:`status_patterns` (status combinations for the census)
+and :func:`measures_dataset` (all of it as ``measures.nc``).
 """
 import itertools
 
@@ -36,13 +21,9 @@ STICK = 1
 def cloud_stats(x, y):
     """Mean, covariance and principal axes of clouds ``(x, y)`` along the last axis.
 
-    Returns a dict of arrays over the leading dimensions: ``mean_x, mean_y,
-    cov_xx, cov_xy, cov_yy`` (population covariance), ``major, minor`` (square
-    roots of the eigenvalues, i.e. RMS extents along the principal axes),
-    ``spread = sqrt(major^2 + minor^2)`` (RMS distance to the mean),
-    ``ratio = minor / major`` (0 for a line, 1 for an isotropic cloud, nan for
-    a point) and ``angle`` of the major axis in degrees, in (-90, 90].
-    """
+    Per leading index: ``mean_x, mean_y, cov_xx, cov_xy, cov_yy``, ``major, minor`` (RMS
+    extents along the principal axes), ``spread``, ``ratio = minor / major`` (0 a line, 1
+    isotropic, nan a point) and ``angle`` of the major axis in degrees, in (-90, 90]."""
     x = np.asarray(x, float)
     y = np.asarray(y, float)
     mx, my = x.mean(-1), y.mean(-1)
@@ -85,15 +66,11 @@ def solutions(fields, threshold):
 
 
 def verdict(tol, zero_spread, warm_spread, floor, decades=2.0, ratio=10.0, plateau=0.5):
-    """True indeterminacy or iteration error, from spreads against tolerance.
+    """True indeterminacy or iteration error, from spreads against a decreasing ``tol``.
 
-    ``tol`` decreasing.  "indeterminacy" when, over the tolerances within
-    ``decades`` of the tightest, the zero-guess spread stays above ``floor``
-    and never falls below ``plateau`` times its value a decade looser, and at
-    the tightest tolerance it is at least ``ratio`` times the warm-start
-    spread; "iteration error" when the zero-guess spread shrinks at least
-    tenfold over those decades; "undecided" otherwise.  Returns ``(verdict, info)``.
-    """
+    "indeterminacy": over the last ``decades`` the zero-guess spread stays above ``floor``,
+    keeps ``plateau`` of its value a decade looser and ends ``ratio`` times the warm-start
+    spread; "iteration error": it shrinks tenfold; else "undecided".  Returns ``(verdict, info)``."""
     tol = np.asarray(tol, float)
     z, w = np.asarray(zero_spread, float), np.asarray(warm_spread, float)
     window = tol <= tol.min() * 10 ** decades * (1 + 1e-9)
@@ -193,14 +170,9 @@ def _switch_distance(n_mobile, body_a, body_b, sticking, sources):
 def contact_relation(traj, ens, labels, g):
     """How the two most frequent solutions differ, contact by contact and grain by grain.
 
-    Returns a dict of per-grain arrays (``delta_x, delta_y``: acceleration of
-    solution 1 minus solution 0; ``rigid_x, rigid_y``: its rigid-motion fit on
-    the clusters of grains joined by contacts sticking in both solutions;
-    ``cluster_size``; ``n_stick_both``, ``n_contacts``: contacts of the grain
-    sticking in both solutions / active in either; ``switch_distance``: sticking
-    links to the nearest grain with a contact whose status differs) and
-    per-contact ``switched`` flags, or None with fewer than two solutions.
-    """
+    Per grain: the acceleration difference, its rigid-motion fit on clusters joined by
+    contacts sticking in both, cluster size, contact counts and sticking links to the nearest
+    switching contact; per contact: ``switched``.  None with fewer than two solutions."""
     if labels.max() < 1:
         return None
     tight = ens.isel(tol=-1)
@@ -271,12 +243,9 @@ def cluster_options(statuses, cluster, max_local=16):
 def status_patterns(statuses, contacts, n_mobile, max_patterns, rng):
     """Status patterns combining the changes seen between the solutions found.
 
-    The contacts whose status differs between any two solutions are grouped into
-    clusters (sharing a grain); each cluster takes one of its options
-    (:func:`cluster_options`).  All combinations when there are at most
-    ``max_patterns``; otherwise every single-cluster change of every solution, then
-    combinations drawn at random (``rng``) up to ``max_patterns``.  Returns
-    ``(patterns, switching, n_clusters)``; patterns equal to a solution's are left out."""
+    Switching contacts are grouped into clusters sharing a grain, each taking one of its
+    options (:func:`cluster_options`): all combinations up to ``max_patterns``, else every
+    single-cluster change plus random combinations.  Returns ``(patterns, switching, n_clusters)``."""
     statuses = np.asarray(statuses, np.int8)
     sw = switching_contacts(statuses)
     if len(sw) == 0:
@@ -317,14 +286,10 @@ def status_patterns(statuses, contacts, n_mobile, max_patterns, rng):
 def cloud_against_census(ens, census, grain, init="zero"):
     """The chosen grain's cloud at the tightest tolerance, read through the census.
 
-    Every converged ``init`` run is labelled with the census solution whose whole
-    acceleration field lies within ``basin_tol |g|`` of its own (-1: none).  With
-    ``X`` the runs' accelerations of ``grain`` and ``Y`` those of their solutions,
-    ``E = X - Y``: the principal axes (RMS extents) of the cloud ``X`` differ from
-    those of ``Y`` by at most ``rms(E)`` (singular values are 1-Lipschitz in the
-    Frobenius norm), so the cloud is a set of solutions with the shape of ``Y``
-    (one point, a segment for two solutions, ...) blurred by the iteration error
-    ``E``.  Returns a dict of counts and axes (m s-2)."""
+    Each converged run is labelled with the census solution within ``basin_tol |g|`` (-1:
+    none).  The cloud's principal axes differ from those of its solutions by at most the RMS
+    iteration error (singular values are 1-Lipschitz), so the cloud is a set of solutions
+    blurred by that error.  Returns counts and axes (m s-2)."""
     import yaml
     tight = ens.sel(init=init).isel(tol=-1)
     ok = tight.converged.values.astype(bool)

@@ -1,19 +1,13 @@
-"""Grain sources of a pile construction (Moreau 2005, section 5; issue 16).
+"""Grain sources of a pile construction (Moreau 2005, section 5): two histories of the same grains.
 
-Two construction histories of the same grains onto the same rough ground:
+* :class:`PointSource` -- a localized source above ``x = 0`` rising with the pile
+  (Figure 4; such piles show a pressure dip under the apex in Vanel et al. 1999 and
+  Geng et al. 2001);
+* :class:`RainSource` -- a uniform rain over ``|x| <= half_width`` (a hump in those experiments).
 
-* :class:`PointSource` -- a localized source above the axis ``x = 0`` that rises
-  with the pile (Figure 4's pile; Vanel et al. 1999 and Geng et al. 2001 find a
-  pressure dip under the apex of such piles);
-* :class:`RainSource` -- the grains rained uniformly over ``|x| <= half_width``
-  (the final base half-width of the point-source pile), from a height that
-  rises with the deposit (such piles show a pressure hump in those experiments).
-
-Both expose ``update_height(pos, radius, vel, age_ok)``, ``draw(pos, radius, limit)``
-and the state a checkpoint needs (``height``, ``taken`` and the generator ``rng``).
-When ``radii`` is given the grains are taken in that order (the same grains for
-both histories); otherwise each radius is drawn from ``rng`` when its site is
-tried (Figure 4's original pile, kept bit for bit).
+Both expose ``update_height``, ``draw`` and the state a checkpoint needs.  Given
+``radii``, grains come in that order (the same grains for both histories); otherwise
+each radius is drawn when its site is tried, which keeps Figure 4's pile bit for bit.
 """
 import numpy as np
 

@@ -1,46 +1,21 @@
-"""Anderson acceleration of NLGS (issue 13, item 2): ``SolverSettings(accel="anderson")``.
+"""Anderson acceleration of NLGS: ``SolverSettings(accel="anderson")``.
 
-NLGS is a fixed-point iteration ``s -> G(s)`` on the impulses: one sweep in the review
-order (the body velocities are ``u_free + M^-1 H s``, a function of ``s``).  Anderson's
-method, type II ("Anderson mixing", Walker & Ni 2011), keeps the last ``m`` differences
-``dF`` of the residuals ``f = G(x) - x`` and ``dG`` of the images ``G(x)``, and extrapolates
+NLGS is a fixed-point iteration ``s -> G(s)`` on the impulses (one sweep in the review
+order).  Type-II Anderson mixing (Walker & Ni 2011) keeps the last ``m`` differences
+``dF`` of the residuals ``f = G(x) - x`` and ``dG`` of the images, and extrapolates
 
     s = proj_C( G(x_k) - dG gamma ),    gamma = argmin |f_k - dF gamma|,
 
-``proj_C`` projecting each contact's impulse on its Coulomb cone (the body velocities
-are then recomputed, :func:`ncd.solver.pack.apply_all`).  ``gamma`` solves the ``m x m``
-normal equations with a Tikhonov term (:data:`REGULARIZATION` times their largest
-diagonal entry) by Cholesky.  Choices by measurement (fig2's step, 545 contacts, 6
-review orders; dense packings):
-
-* an Anderson step after every :data:`PERIOD`-th sweep only ("alternating" Anderson,
-  Pratapa, Suryanarayana & Pask 2016): an Anderson step with memory 20 costs 1.4 sweeps
-  on fig2's step (14 us against 10 us; 31 us before the Gram row's dot products were
-  vectorized, :func:`_dots`); to 1e-10 there, one after every sweep took 590-710 sweeps,
-  after every 2nd 610-940, every 3rd or 4th up to 2,800 (more stalls);
-* safeguard: when ``|f|`` (at the Anderson steps) has not dropped below :data:`STALL_FACTOR` of its last mark
-  within ``STALL_SPAN m`` Anderson steps, the history is cleared and ``m 2^(r-1)`` plain
-  sweeps follow the ``r``-th restart.  Without it 1 run in 3 to 6 stagnated at residuals
-  1e-3 to 1e-5 on fig2's step (status switching defeats the extrapolation); with it all
-  6 reached 1e-10.  (Restarting only when ``|f|`` grows did not cure the stagnation.)
-
-Measured to a residual of 1e-10 from the zero guess, memory 20 (NLGS sweeps, plain
-NLGS's in brackets): fig2's former step 70 620-900 over 6 review orders (8,720-9,070);
-fig2's step 50, where zero-guess runs end on two solutions, 880-1,310 on 3 orders but
-8,430, 86,630 and 103,970 on the other 3 (7,620-10,670): the extrapolation mixes iterates
-that the status switches send towards different solutions; 10^3-disc
-packing 190-210 (3,440-3,790); 10^4-disc packing 1,110 (29,530).  Wall time 5.1-7.5x,
-8.8-9.5x and 10.5-11.9x shorter: on fig2's step the sweep count falls 10-14x, and the Anderson
-steps take the rest.  The pile's final state (Figure 4) is not helped: NLGS and AA
-both stall at residuals ~1e-6 (``finish="active_set"``, :mod:`ncd.solver.finish`, is the route there); AA
-without the safeguard, memory 50 or 100, jumped from ~1e-6 to below 1e-10 in 3 of 12
-runs (3 review orders) and stalled in the others.
-
-The natural-map residual, the stopping test and the best-iterate record are those of
-:mod:`ncd.solver.nlgs`, evaluated on sweep outputs only: the returned impulses and body
-velocities are always those of a sweep, consistent with each other.  In chunked runs
-(an ``observe`` callable, :mod:`ncd.solver.convergence`) the last sweep of a chunk is not
-extrapolated; the history goes on across chunks.
+``proj_C`` projecting each impulse on its Coulomb cone, the body velocities then
+recomputed (:func:`ncd.solver.pack.apply_all`); ``gamma`` solves the normal equations
+with a Tikhonov term (:data:`REGULARIZATION`) by Cholesky.  An Anderson step follows
+every :data:`PERIOD`-th sweep ("alternating" Anderson, Pratapa, Suryanarayana & Pask
+2016).  Status switches defeat the extrapolation, so a safeguard clears the history
+when ``|f|`` stops falling (:data:`STALL_FACTOR`, :data:`STALL_SPAN`) and runs
+``m 2^(r-1)`` plain sweeps after the ``r``-th restart.  Residual, stopping test and best
+iterate are those of :mod:`ncd.solver.kernels`, taken on sweep outputs, and a call's last
+sweep is not extrapolated: the returned impulses and velocities are a sweep's, consistent
+with each other.  Trade-offs: docs/solvers.md.
 """
 import numpy as np
 
@@ -69,7 +44,7 @@ def state(flat, memory):
 
 
 def driver(flat, memory):
-    """A callable with the signature of :func:`ncd.solver.nlgs.iterate_discs` running the
+    """A callable with the signature of :func:`ncd.solver.kernels.iterate_discs` running the
     accelerated iteration (its state kept between calls: chunks of
     :func:`ncd.solver.convergence.run_nlgs` continue one history)."""
     aa = state(flat, memory)
@@ -127,9 +102,9 @@ def _solve_spd(A, b, n, reg):
 @njit(cache=True, error_model="numpy", fastmath={"reassoc"})
 def _dots(a, b, c):
     """``(a . b, a . c)`` in one pass.  ``reassoc`` (and no other fast-math flag) lets LLVM
-    vectorize the two sums (3x faster than a fixed scalar order; the Gram row was half
-    an Anderson step).  The summation order is then fixed by the compiled code: the same
-    bits on every run, thread count and shard of a given machine and numba build."""
+    vectorize the two sums, the bulk of an Anderson step's Gram row.  The summation order
+    is then fixed by the compiled code: the same bits on every run, thread count and shard
+    of a given machine and numba build."""
     s = 0.0
     t = 0.0
     for i in range(a.shape[0]):
@@ -207,7 +182,7 @@ def _anderson_step(data, aa):
 
 @njit(cache=True, nogil=True, error_model="numpy")
 def _iterate_anderson(data, order, status, scale, tol, max_sweeps, criterion, check_every, best, aa):
-    """The driver of :func:`ncd.solver.nlgs.iterate_discs` with an Anderson step after every
+    """The driver of :func:`ncd.solver.kernels.iterate_discs` with an Anderson step after every
     :data:`PERIOD`-th sweep (``aa``: :func:`state`); the residual and the best iterate are
     taken on sweep outputs, and the last sweep of a call is not extrapolated."""
     keep, keep_imp, keep_status, keep_body, k0 = best

@@ -1,21 +1,16 @@
 """Convergence record of a run: is the iterate a solution in what the figure uses?
 
-A run is *converged* only when both hold (issue 13, item 1):
-
-* its relative natural-map residual is ``<= tol`` (:mod:`ncd.solver.nlgs`);
-* the figure's observable has stopped changing: ``observe(impulse, vel, spin)``
-  returns a 1-D array scaled to order one (a force over the weight, a speed over
-  ``|g| h``); NLGS then runs in chunks of ``check_every`` sweeps and
-  ``observable_change`` is the largest change of the observable over the last
-  :data:`WINDOW` residual checks, over ``max(1, |observable|)``.
-
-A converged run is then classified by what its end-of-step velocities say:
-``rest`` when the largest grain speed ``|u_f|`` (translation and ``r omega``) over
-``|g| h`` is ``<= speed_tol``, ``motion`` otherwise (a partial collapse, the wedged
-disc falling): a different outcome, never mixed into a cloud of rest states.
-
-The chunked driver calls the numba drivers of :mod:`ncd.solver.nlgs` from Python with a
-budget of one chunk each time: no Python function reaches a cached kernel.
+A small residual alone can leave grains moving, so a run is *converged* only when both
+hold: its relative natural-map residual is ``<= tol`` (:mod:`ncd.solver.kernels`), and
+the figure's observable has settled.  ``observe(impulse, vel, spin)`` returns a 1-D
+array scaled to order one (a force over the weight, a speed over ``|g| h``); NLGS then
+runs in chunks of ``check_every`` sweeps and ``observable_change`` is the largest change
+over the last :data:`WINDOW` checks, over ``max(1, |observable|)``.  A converged run is
+classified (:func:`classify`) as ``rest`` when its largest grain speed over ``|g| h`` is
+``<= speed_tol``, ``motion`` otherwise (a partial collapse, the wedged disc falling): a
+different outcome, never mixed into a cloud of rest states.  The chunks call the numba
+drivers of :mod:`ncd.solver.kernels` from Python, so no Python function reaches a cached
+kernel.
 """
 import numpy as np
 
@@ -38,7 +33,7 @@ def observable_change(history):
 
 
 def run_nlgs(iterate, data, order, status, scale, settings, observe=None):
-    """Run an NLGS driver of :mod:`ncd.solver.nlgs` (``iterate_discs`` or ``iterate_local``).
+    """Run an NLGS driver of :mod:`ncd.solver.kernels` (``iterate_discs`` or ``iterate_local``).
 
     Without ``observe`` the whole budget is one call.  With it, calls of
     ``check_every`` sweeps each, then ``observe()``; the run stops when the residual

@@ -1,54 +1,17 @@
-"""Finishing stage: the exact solution NLGS converges towards (issue 13, item 2).
+"""Active-set finishing stage: the exact solution NLGS is converging towards.
 
-NLGS settles the *status* of every contact (open, stick, slide forward or
-backward) long before its impulses converge, and on a dense or indeterminate
-problem (a pile at rest, a wedged grain) its last decades of residual take
-most of the sweeps, or never come.  With the statuses fixed the one-step
-solutions form a polyhedron (2-D Coulomb cones are polyhedral,
-:mod:`ncd.solver.finish_lp`), so the finishing stage (:func:`polish`):
-
-1. lets NLGS go on while its own rate predicts ``finish_tol`` soon
-   (within :data:`LP_SWEEPS` sweeps);
-2. otherwise projects the iterate ``s_k`` on the polyhedron of its statuses: the
-   point ``s`` nearest to ``s_k`` in the L1 norm (an LP, HiGHS), a small
-   correction that stays on the solution NLGS is approaching (no jump to another
-   one of an indeterminate problem);  an elastic LP naming the contacts whose status
-   is wrong (``ncd.solver.finish_lp.project(elastic=...)``) was tried on the pile: it never made
-   the polyhedron non-empty and cost twice a projection, so it is not used; nor is a
-   mixed-integer projection (HiGHS branch and bound choosing the statuses of the least
-   settled contacts, big-M Signorini-Coulomb rows): on the pile, order 1 of the bench, it
-   was infeasible with 40 free contacts and found no incumbent in 60 s with 200;
-3. accepts the projection when its relative natural-map residual is ``<= finish_tol``
-   and it moves the impulses by at most :data:`MAX_CORRECTION` (relative L1);
-   otherwise NLGS goes on (chunks growing 4x, within the sweep budget) and 2 is tried
-   again (:data:`MAX_ATTEMPTS` times at most).  When the budget runs out the best
-   iterate seen is returned, unconverged.
-
-When the iterate's statuses give an empty polyhedron and the residual is below
-:data:`REST_GATE`, the polyhedron of :func:`rest_status` (every contact sticking: the
-states at rest, A ∩ C times ``h``) is tried the same way.
-
-Measured on the 1000-grain pile's final state (Figure 4, 1721 contacts) from the zero
-guess, 32 random review orders, handing over at 1e-5: every run reaches a residual
-<= 1e-10 (largest 6e-11) in 2.6-6.9 s.  NLGS drifts near 1e-6 (its impulses change by
-a constant ~5e-10 per sweep), the polyhedron of its statuses is empty, and the nearest
-state at rest is 2.2-2.6 % away (L1): 28 runs end at rest (grains below 3e-11 g h).
-Four end on a motion solution (a grain wedged between two neighbours falls free, speed
-g h, and 19 grains at the apex move at 0.01-0.7 g h): two reached by NLGS alone, two by
-the status projection (0.7 % away).  HiGHS's crossover is
-capped (:data:`ncd.solver.finish_lp.SIMPLEX_LIMIT`): uncapped, one empty polyhedron kept it
-20 s without an answer.  Where NLGS converges at a steady rate (fig2's step, dense
-packings) the stage is NLGS itself, with chunks that run to their end: on fig2's step
-19,720 sweeps to 1e-10 against plain NLGS's 8,720.  Stopping a chunk at the first check
-below ``finish_tol`` was tried and dropped: stopped at 1e-10, the grains of the
-convergence test's column moved at 8e-9 g h (where that test bounds a finished state by
-1e-9) and no run of the reduced pile passed the rest bound (1e-8 g h); the run to the
-chunk's end takes the residual far below the target (~1e-14).
-
-:func:`check_solution` checks a solution componentwise (cone, complementarity,
-sticking and sliding velocities).  :func:`project_statuses` (the minimum-norm point
-of the affine set of a status pattern, sparse LU) serves the census of
-:mod:`ncd.figures.census`, which enumerates status patterns.
+NLGS settles every contact's *status* (open, stick, slide forward or backward) long
+before its impulses converge.  In 2-D the Coulomb cone is polyhedral, so the one-step
+solutions sharing a status pattern form a polyhedron (:mod:`ncd.solver.finish_lp`).
+:func:`polish` lets NLGS go on while its own rate predicts ``finish_tol`` within
+:data:`LP_SWEEPS` sweeps; otherwise it projects the iterate on the polyhedron of its
+statuses (nearest point in L1, an LP) and accepts the projection only if its residual
+is ``<= finish_tol`` and it moves the impulses by at most :data:`MAX_CORRECTION`, so
+that it stays on the solution NLGS approaches instead of jumping to another one of an
+indeterminate problem.  An empty polyhedron near a solution falls back on the states
+at rest (:func:`rest_status`).  :func:`check_solution` checks a solution
+componentwise; :func:`project_statuses` (minimum-norm point of a status pattern's
+affine set) serves the census of :mod:`ncd.figures.census`.  Trade-offs: docs/solvers.md.
 """
 import logging
 
@@ -63,7 +26,7 @@ from ncd.solver.single_contact import NO_CONTACT, SLIDE_BACKWARD, SLIDE_FORWARD,
 
 FIRST_CHUNK = 50         # NLGS sweeps (at least; a quarter of those made) that measure NLGS's rate
 LP_SWEEPS = 50000        # NLGS goes on while its rate predicts finish_tol within this many sweeps
-MAX_ATTEMPTS = 3         # failed projections (an empty polyhedron costs 10-20 s on the pile) before NLGS alone
+MAX_ATTEMPTS = 3         # failed projections (an empty polyhedron is a long LP) before NLGS alone
 REST_GATE = 1e-5         # the rest polyhedron is tried from iterates this close only (far ones: long LPs, rejected)
 MAX_CORRECTION = 0.05    # a projection moving the impulses by more (relative L1) is a jump: rejected
 LOG = logging.getLogger(__name__)
@@ -93,7 +56,7 @@ def natural_map(s, U, mu, rho):
 
 
 def relative_residual(s, U, mu, rho, scale):
-    """The relative natural-map residual of :mod:`ncd.solver.nlgs`."""
+    """The relative natural-map residual of the NLGS kernels (:mod:`ncd.solver.kernels`)."""
     F, _ = natural_map(s, U, mu, rho)
     return float(np.sqrt(np.sum(F ** 2)) / max(scale, np.sqrt(np.sum(s ** 2)), 1e-300))
 
@@ -159,18 +122,12 @@ def project_statuses(W, q, mu, s0, status):
 
 
 def polish(lp, W, q, mu, rho, scale, s0, status0, tol, more_sweeps, max_sweeps, sweeps0):
-    """Finishing stage from the NLGS iterate ``s0`` (statuses ``status0``, after ``sweeps0`` sweeps).
-
-    NLGS goes on (``more_sweeps(k) -> (s, status)``; a first chunk measures its rate)
-    while its rate predicts ``tol`` within :data:`LP_SWEEPS` sweeps.  Otherwise the
-    iterate is projected on the polyhedron of its statuses (:func:`ncd.solver.finish_lp.project`).
-    A projection is accepted when its natural-map residual is
-    ``<= tol`` and it moves the impulses by at most :data:`MAX_CORRECTION` (relative L1;
-    a larger move reaches another solution).  Else NLGS goes on (chunks growing 4x) and
-    the projection is tried again, :data:`MAX_ATTEMPTS` times at most.  Returns ``(s,
-    status, residual, lp_solves, ok, extra_sweeps, correction)``: the best iterate when
-    the sweep budget runs out; ``correction`` is ``|s - s_k|_1 / |s_k|_1`` of the
-    accepted projection (0 when NLGS got there)."""
+    """Finishing stage (module docstring) from the NLGS iterate ``s0`` (``status0``, after
+    ``sweeps0`` sweeps); ``more_sweeps(k) -> (s, status)`` runs NLGS on.  Failed projections
+    are retried after chunks growing 4x, :data:`MAX_ATTEMPTS` times at most.  Returns ``(s,
+    status, residual, lp_solves, ok, extra_sweeps, correction)``, the best iterate when the
+    budget runs out; ``correction`` is ``|s - s_k|_1 / |s_k|_1`` of the accepted projection
+    (0 when NLGS got there)."""
     def residual(s):
         return relative_residual(s, (W @ s.ravel() + q).reshape(-1, 2), mu, rho, scale)
 
@@ -231,13 +188,11 @@ def rest_status(lp):
 
 
 def check_solution(impulse, U, mu, tol=1e-8, velocity_scale=None):
-    """Componentwise check of the Signorini-Coulomb law; returns a dict of the largest
-    violations (impulses over ``max |s|``, velocities over ``velocity_scale``, default
-    ``max |U|``; pass the free-velocity scale, e.g. ``|g| h``, at rest) and ``ok``.
-
-    cone: ``s_n >= 0``, ``|s_t| <= mu s_n``; normal complementarity ``U_n >= 0``,
-    ``s_n U_n = 0``; sticking contacts (``|s_t| < mu s_n``): ``U_t = 0``; sliding
-    ones: ``U_t`` opposite to ``s_t`` (``s_t U_t <= 0``)."""
+    """Componentwise check of the Signorini-Coulomb law: a dict of the largest violations
+    and ``ok``.  Cone ``s_n >= 0``, ``|s_t| <= mu s_n``; ``U_n >= 0``, ``s_n U_n = 0``;
+    sticking (``|s_t| < mu s_n``): ``U_t = 0``; sliding: ``s_t U_t <= 0``.  Impulses are
+    scaled by ``max |s|``, velocities by ``velocity_scale`` (default ``max |U|``; pass the
+    free-velocity scale, e.g. ``|g| h``, for a state at rest)."""
     s = np.asarray(impulse, float).reshape(-1, 2)
     U = np.asarray(U, float).reshape(-1, 2)
     S = max(float(np.abs(s).max(initial=0.0)), 1e-300)
@@ -291,7 +246,7 @@ def polish_discs(scene, contacts, vel, spin, bias, q_free, Wb, flat, order, resu
         iterate_discs(flat, order, status, scale, 0.0, k, 0, k, keep)
         return imp.reshape(n, 2).copy(), status.copy()
 
-    # q of U = W s + q: the free local velocity (bias included) of :func:`solve_discs`
+    # q of U = W s + q: the free local velocity (bias included) of :func:`ncd.solver.nlgs.solve_discs`
     nm = scene.n_mobile
     free = np.column_stack([vel[:nm], spin[:nm]]).ravel()       # u_free (vel, spin untouched so far)
     lp = StatusLP.discs(H, minv, free, bias, contacts.mu, scene.radius[:nm],

@@ -25,10 +25,10 @@ import scipy.sparse as sp
 from ncd.solver.single_contact import NO_CONTACT, SLIDE_BACKWARD, SLIDE_FORWARD, STICK
 
 FEASIBILITY = 1e-9       # HiGHS primal feasibility tolerance, of the scaled rows
-# Crossover iterations at most: on the pile's final state (review order 0 of the bench) the
-# polyhedron of the NLGS statuses is empty, the interior-point stage does not say so, and
-# crossover ran 13,000 iterations (20 s) without an answer; the projections that succeed
-# take 0-25.  A count, not a time limit: the outcome does not depend on the machine's load.
+# Crossover iterations at most: when the polyhedron of the NLGS statuses is empty the
+# interior-point stage does not say so and an uncapped crossover can run on without an
+# answer, while the projections that succeed need few.  A count, not a time limit: the
+# outcome does not depend on the machine's load.
 SIMPLEX_LIMIT = 2000
 OPTIONS = {"threads": 1, "solver": "ipm", "run_crossover": "on", "primal_feasibility_tolerance": FEASIBILITY,
            "dual_feasibility_tolerance": 1e-9, "simplex_iteration_limit": SIMPLEX_LIMIT}
@@ -91,6 +91,7 @@ def project(lp, s0, status, elastic=0.0):
     # cone rows: mu s_n - s_t >= 0 (= 0 backward), mu s_n + s_t >= 0 (= 0 forward)
     ia = np.nonzero((st == STICK) | (st == SLIDE_BACKWARD))[0]
     ib = np.nonzero((st == STICK) | (st == SLIDE_FORWARD))[0]
+
     def zero(m):
         return sp.csr_matrix((m, ny))
     rows = [Bn, Bt[closed], sp.hstack([zero(len(ia)), _cone_rows(ia, lp.mu, -1.0, n)]),

@@ -8,7 +8,8 @@ incrementally, ``u += M^-1 H_alpha (s_new - s_old)`` (packed arrays of
 :mod:`ncd.solver.pack`), so a sweep costs O(contacts); in local form ``U = W s + q``
 with ``W`` in CSR. The residual is the natural map, ``rho_alpha = 1 / W_alpha,nn``,
 relative to the largest of ``|s|`` and ``|rho q_free|`` (:func:`problem_scale`).
-These are shared by the plain driver, Anderson acceleration and the finishing stage.
+They are shared by plain NLGS, Anderson acceleration, local exact solves and the
+finishing stage.
 """
 
 import numpy as np
@@ -19,10 +20,10 @@ from ncd.solver.single_contact import natural_map_sq, solve_single_contact
 
 
 # The drivers below are written once per form on purpose: passing the sweep and
-# residual functions as arguments to one cached driver keys numba's on-disk cache
-# on the dispatcher objects of the current process, so every process recompiled
-# the driver, appended one more entry to the cache index, and eventually failed
-# to pickle the index ("underlying object has vanished").
+# residual functions as arguments to one cached driver would key numba's on-disk
+# cache on the dispatcher objects of the current process, so every process would
+# recompile the driver, add an entry to the cache index, and eventually fail to
+# pickle the index ("underlying object has vanished").
 @njit(cache=True, inline="always")
 def check_now(k, change, tol, max_sweeps, criterion, check_every):
     return k % check_every == 0 or k == max_sweeps or (criterion == 1 and change <= tol)

@@ -1,35 +1,17 @@
-"""Local exact solves where NLGS stalls (issue 13, item 2): ``SolverSettings(local_exact=True)``.
+"""Local exact solves where NLGS stalls: ``SolverSettings(local_exact=True)``.
 
-On Figure 2's step NLGS (plain or Anderson-accelerated) reaches a residual of ~1e-7
-in a few thousand sweeps from the previous step's impulses, then stays there for
-~150,000 sweeps: a few contacts drift by a constant small amount per sweep towards
-the solution, along a direction the sweeps barely move.  A local exact solve goes
-there at once.  The run is made in chunks of :data:`CHUNK` sweeps; when the residual
-has not fallen below :data:`STALL_FACTOR` of its value :data:`STALL_WINDOW` chunks
-earlier, the *region* is formed:
-
-* its seed: the :data:`SEED` contacts whose impulses moved most over the last chunk
-  (the drift);
-* grown by the other contacts of the seed's mobile grains, at most
-  :data:`MAX_REGION` contacts (those that moved most).
-
-With every other impulse frozen, the region's problem ``U_R = W_RR s_R + q_R`` is
-the LCP of :func:`ncd.solver.lcp.frictional_lcp` (size 3 x region), solved exactly by
-Lemke's method (:func:`ncd.solver.lcp.lemke`); its solution replaces the region's impulses,
-the body velocities are recomputed (``u = u_free + M^-1 H s``), Anderson's history
-is cleared, and the sweeps go on.  A Lemke run without a solution leaves the
-iterate as it is.  The stopping test, the residual and the best-iterate record stay
-those of :mod:`ncd.solver.nlgs` (the returned iterate is a sweep's output).
-
-Measured on Figure 2's step 50 (552 contacts) from the previous step's impulses, to
-1e-10 (the benchmark ``bench_tolerance``, identity and 2 random review orders): plain NLGS
-150,930-165,130 sweeps, 0.91-0.96 s; with local solves 8,870-9,970 sweeps, 0.058-0.063 s; with
-Anderson and local solves 1,600-2,130 sweeps, 0.022-0.028 s; both on plain NLGS's own
-solution (end-of-step velocities within 7e-7 |g| h).  Seeding the region with the largest
-natural-map residuals instead of the drift left one of six orders on its plateau (the
-region's Lemke solution was the stalled iterate itself).  Where the slow mode is global
-(the pile's final state, Figure 4) local solves do not help: :mod:`ncd.solver.finish` is the
-route there.
+Warm-started NLGS (plain or Anderson) can sit on a residual plateau: a few contacts
+drift by a small constant amount per sweep along a direction the sweeps barely move.
+A local exact solve goes there at once.  The run is made in chunks of :data:`CHUNK`
+sweeps; when the residual has not fallen below :data:`STALL_FACTOR` of its value
+:data:`STALL_WINDOW` chunks earlier, a *region* is formed (:func:`region`): the
+:data:`SEED` contacts whose impulses moved most over the last chunk (the drift, not the
+largest residuals, which can point at the stalled iterate itself), grown by the other
+contacts of their mobile grains, :data:`MAX_REGION` at most.  With every other impulse
+frozen, the region's problem is the LCP of :func:`ncd.solver.lcp.frictional_lcp`, solved
+by Lemke's method; its solution replaces the region's impulses, the body velocities are
+recomputed and Anderson's history cleared.  The stopping test and best-iterate record
+stay those of :mod:`ncd.solver.kernels`.  Trade-offs: docs/solvers.md.
 """
 import numpy as np
 
@@ -107,13 +89,12 @@ class LocalExact:
             self.reset()
 
     def driver(self, iterate):
-        """A callable with the signature of :func:`ncd.solver.nlgs.iterate_discs`: ``iterate``
-        in chunks of at most :data:`CHUNK` sweeps, the residual recorded every
-        :data:`CHUNK` sweeps (across calls: the chunked runs of :mod:`ncd.solver.convergence`
-        call it ``check_every`` sweeps at a time), a local exact solve after a stall.
-        The solve is made before the next sweeps, never as a call's last act: the
-        iterate a call returns is always a sweep's output.  The residual of a chunk is the one
-        ``iterate`` returns: it checks at its last sweep."""
+        """A callable with the signature of :func:`ncd.solver.kernels.iterate_discs`: ``iterate``
+        in chunks of :data:`CHUNK` sweeps (counted across calls, which the chunked runs of
+        :mod:`ncd.solver.convergence` make ``check_every`` sweeps at a time), each chunk's
+        residual the one ``iterate`` returns (it checks at its last sweep).  A stall's solve
+        is made before the next sweeps, never as a call's last act: the iterate a call
+        returns is always a sweep's output."""
         history = []
         period = {"start": None, "since": 0, "pending": None}
 

@@ -1,25 +1,15 @@
-"""Nonlinear Gauss-Seidel (NLGS) for the core problem of a Contact Dynamics step.
+"""Nonlinear Gauss-Seidel (NLGS): the front door of the solver layer.
 
-Contacts are reviewed one at a time in a given ``review_order``; each is
-solved exactly (:func:`ncd.solver.single_contact.solve_single_contact`) with the other
-impulses frozen, and the result is propagated at once (Moreau 2005, section 2).
-Two forms of the same problem share the iteration driver:
-
-* disc form: body velocities ``u`` are updated incrementally,
-  ``u += M^-1 H_alpha (s_new - s_old)``, so a sweep costs O(contacts);
-* local form: ``U = W s + q`` with a Delassus matrix ``W`` given dense or
-  sparse, as NSCD codes (LMGC90, Siconos) export 2-D frictional problems.
-
-Each run reports its sweeps, the relative impulse change of the last sweep,
-the relative natural-map residual (:func:`ncd.solver.single_contact.natural_map_sq`,
-``rho_alpha = 1 / W_alpha,nn``, divided by the largest of ``|s|`` and
-``|rho q_free|``) and a converged flag.  The stopping criterion is either the
-residual (default) or the change; non-convergence at ``max_sweeps`` is flagged,
-and the iterate returned is then the one of smallest residual seen (``keep_best``).
-With ``finish="active_set"`` the NLGS iterate is finished to ``finish_tol`` by
-:mod:`ncd.solver.finish` (projection on the polyhedron of its contact statuses, an LP); with an ``observe`` callable the run is made in chunks of
-``check_every`` sweeps and stops only when the observable has settled too
-(:mod:`ncd.solver.convergence`).
+Contacts are reviewed one at a time in a ``review_order``; each is solved exactly
+with the other impulses frozen and the result propagated at once (Moreau 2005,
+section 2).  Two forms of one problem share the drivers of :mod:`ncd.solver.kernels`:
+:func:`solve_discs` (body velocities updated incrementally, packed by
+:mod:`ncd.solver.pack`: a sweep costs O(contacts)) and :func:`solve_local`
+(``U = W s + q`` with ``W`` dense or sparse, as LMGC90 and Siconos export 2-D
+problems).  This module composes the variants chosen by
+:class:`ncd.solver.settings.SolverSettings`: Anderson acceleration, local exact solves,
+chunked runs with an observable (:mod:`ncd.solver.convergence`) and the active-set
+finishing stage (:mod:`ncd.solver.finish`); none of them imports it back.
 """
 
 import numpy as np
@@ -39,8 +29,7 @@ from ncd.solver.local_exact import LocalExact
 from ncd.solver.pack import apply_all, pack_problem
 from ncd.solver.settings import NLGSResult, SolverSettings, check_settings_arg
 
-# ---------------------------------------------------------------- disc form
-# The packed arrays and their per-contact kernels: :mod:`ncd.solver.pack`.
+# ------------------------------------------------------------ entry points
 
 
 def restitution_bias(contacts, U_initial):
@@ -119,7 +108,7 @@ def solve_local(W, q, mu, guess=None, review_order=None, settings=SolverSettings
 
     Find ``s`` (n, 2) with ``U = W s + q`` and the Coulomb law at each contact.
     ``W`` is (2n, 2n), dense or scipy.sparse, rows ordered (n_1, t_1, n_2, ...);
-    ``q`` (2n,); ``mu`` scalar or (n,).  Checks: :func:`ncd.check_local_problem`.
+    ``q`` (2n,); ``mu`` scalar or (n,).  Checks: :func:`check_local_problem`.
     """
     W, q, mu, guess, review_order = check_local_problem(W, q, mu, guess, review_order, settings)
     if settings.accel != "none":
@@ -154,10 +143,14 @@ def solve_local(W, q, mu, guess=None, review_order=None, settings=SolverSettings
     return result
 
 
-# ------------------------------------------------------------ the local form
+# ------------------------------------------------------------ argument checks
 def check_local_problem(W, q, mu, guess, review_order, settings):
-    """All arguments of :func:`ncd.solve_local` (policy in the module docstring);
-    returns ``(Wc, q, mu, guess, order)`` with ``Wc`` CSR."""
+    """All arguments of :func:`ncd.solve_local`; returns ``(Wc, q, mu, guess, order)``, ``Wc`` CSR.
+
+    ``W`` is square ``2 n`` and finite; each diagonal 2x2 block ``B`` must be positive
+    definite as ``x . B x > 0`` (its symmetric part is), which makes it invertible and
+    admits the non-symmetric blocks the single-contact solver handles.  The coupling
+    blocks are not checked: an NLGS diverging on them ends in :class:`ncd.SimulationError`."""
     q = array("q", q, (None,))
     if len(q) % 2:
         raise InputError(f"q has length {len(q)}, expected 2 n (rows n_1, t_1, n_2, ...)")
@@ -183,7 +176,7 @@ def check_local_problem(W, q, mu, guess, review_order, settings):
 
 
 def check_disc_problem(s, c, vel, spin, guess, review_order, settings, bias, W):
-    """All arguments of :func:`ncd.solve_discs`; returns ``(guess, order, bias)``."""
+    """All arguments of :func:`ncd.solve_discs`; returns ``(guess, order, bias, W)``."""
     check_scene(s)
     check_contacts(s, c)
     n, nd = c.n, s.n_disc

@@ -1,5 +1,6 @@
-"""The disc-form problem of :mod:`ncd.solver.nlgs` packed for its hot loop, and the
-per-contact kernels on the packed arrays (``U = H_c^T u``, ``u += M^-1 H_c ds``).
+"""The disc-form problem (:func:`ncd.solver.nlgs.solve_discs`) packed for the hot loop of
+:mod:`ncd.solver.kernels`, and the per-contact kernels on the packed arrays
+(``U = H_c^T u``, ``u += M^-1 H_c ds``).
 """
 import numpy as np
 

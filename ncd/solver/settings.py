@@ -20,22 +20,19 @@ MAX_ACCEL_MEMORY = 100    # stored differences of Anderson acceleration at most
 
 @dataclass(frozen=True)
 class SolverSettings:
-    """NLGS settings: tolerance on the chosen criterion, sweep budget, finishing stage.
+    """NLGS settings: tolerance on the chosen criterion, sweep budget, variants.
 
-    ``finish``: "none" (plain NLGS) or "active_set" (:func:`ncd.solver.finish.polish`: where
-    NLGS's rate is slow, its iterate projected (L1, LP) on the solutions with the contact
-    statuses it has settled, the active set, until the natural-map residual is <= ``finish_tol``).
-    ``observable_tol``: largest relative change of an observed quantity over the
-    last residual checks for a run to count as converged (:mod:`ncd.solver.convergence`).
+    ``finish``: "none" or "active_set" (:mod:`ncd.solver.finish`: the iterate projected on
+    the solutions with the contact statuses NLGS has settled, to ``finish_tol``).
+    ``observable_tol``: largest relative change of an observed quantity over the last
+    residual checks for a converged run (:mod:`ncd.solver.convergence`).
     ``keep_best``: at ``max_sweeps`` return the iterate of smallest residual seen
-    (``False``: the last sweep's, as LMGC90 and Siconos do; the stability study's
-    setting, since time steps going on from the best iterate made its 10^6 stack gain energy).
-    ``accel``: "none" (plain NLGS) or "anderson" (:mod:`ncd.solver.anderson`: Anderson
-    acceleration of the sweeps with ``accel_memory`` stored differences, disc form only;
-    memory 0 is plain NLGS).
-    ``local_exact``: where the residual stalls, the contacts drifting most and their
-    grains' other contacts solved exactly by Lemke's method, the other impulses frozen
-    (:mod:`ncd.solver.local_exact`; disc form only).
+    (``False``: the last sweep's, as LMGC90 and Siconos do; time stepping that goes on
+    from the best iterate can gain energy).
+    ``accel``: "none" or "anderson" (:mod:`ncd.solver.anderson`, ``accel_memory`` stored
+    differences, 0 being plain NLGS; disc form only).
+    ``local_exact``: exact solves of the drifting contacts' region where the residual
+    stalls (:mod:`ncd.solver.local_exact`; disc form only).  Trade-offs: docs/solvers.md.
     """
     tol: float = 1e-8
     max_sweeps: int = 20000

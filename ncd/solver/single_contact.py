@@ -1,28 +1,20 @@
 """The single-contact problem of 2-D Coulomb friction, solved exactly.
 
-One contact alpha, its impulse ``r = (r_n, r_t)`` and its relative velocity
-``U = W r + q`` (``W`` the 2x2 local Delassus block, ``q`` the velocity the
-contact would have without its own impulse).  The contact law (Moreau 2005,
-section 2; Moreau 2004a) is the impulsional Signorini-Coulomb law
+One contact, its impulse ``r = (r_n, r_t)`` and relative velocity ``U = W r + q`` (``W``
+the 2x2 local Delassus block, ``q`` the velocity without its own impulse), under the
+impulsional Signorini-Coulomb law (Moreau 2005, section 2; Moreau 2004a):
 
     r_n >= 0,  U_n >= 0,  r_n U_n = 0,
     |r_t| <= mu r_n,  |r_t| < mu r_n  =>  U_t = 0,
     |r_t| = mu r_n > 0  =>  U_t = -lambda r_t  (lambda >= 0).
 
-It is solved by enumerating its four cases: no contact, stick, slide with
-``U_t > 0`` (``r_t = -mu r_n``), slide with ``U_t < 0`` (``r_t = +mu r_n``).
-``W`` is a full 2x2 block (symmetric positive definite), not only the diagonal
-block of a disc.  For a disc contact the solution is unique; for a strongly
-coupled block and a large ``mu`` the first admissible case in the order above
-is returned.
-
-The error measure of the whole problem is built from the natural map of the
-Coulomb problem with De Saxce's modified velocity
-``U~ = (U_n + mu |U_t|, U_t)``:
-
-    F(r) = r - proj_K(r - rho U~),
-
-which vanishes exactly at solutions (``rho = 1 / W_nn`` makes it an impulse).
+It is solved by enumerating its cases: no contact, stick, slide with ``U_t > 0``, slide
+with ``U_t < 0``.  ``W`` may be any positive definite 2x2 block (local form), not only a
+disc's diagonal one.  A disc contact's solution is unique; where a strongly coupled
+block and a large ``mu`` admit several cases, the first in that order is returned.
+The error measure is the natural map with De Saxce's modified velocity
+``U~ = (U_n + mu |U_t|, U_t)``, ``F(r) = r - proj_K(r - rho U~)``, which vanishes
+exactly at solutions (``rho = 1 / W_nn`` makes it an impulse).
 """
 import numpy as np
 

@@ -1,25 +1,12 @@
-"""Benchmarks of the solver (issues 2 and 6): measurements, not tests.
+"""Benchmarks of the solver: measurements, not tests.
 
-* :func:`core_table`: on dense packings of 10^3 to 10^5 discs, the cost of one
-  NLGS contact update (ns) of the numba sweep and of the same loop in plain C
-  (``c_sweep.c``, gcc -O3 -ffp-contract=off, on the same packed
-  arrays: the hardware reference, which must return the same impulses bit for bit),
-  contact detection, step preparation, the time per Moreau-Jean step and the
-  peak memory of building and stepping the scene;
-* :func:`sweeps_table`: the sweeps NLGS needs to reach a fixed tolerance
-  as N grows, from the zero guess and from the warm start;
-* :func:`ensemble_table`: an ensemble of NLGS runs on 1 and on 2 threads
-  (:func:`ncd.dynamics.explore.run_parallel`): speed-up and bit-for-bit equality;
-* :func:`startup`: ``import ncd`` and a first step in a fresh interpreter
-  with a warm numba cache;
-* :func:`rule_times`: the wall time and memory of every pipeline rule, read
-  from Snakemake's ``benchmark:`` files.
-
-The packing is a triangular lattice of spacing ``s`` (rows alternately shifted
-by ``s/2``, positions jittered by ``1e-3 s``) in a box (floor and two side
-walls) under gravity, radii ``s/2 (1.005 + 0.02 u)``, ``u`` uniform in [0, 1]:
-every lattice neighbour pair overlaps by 0.5 % to 4.5 % of ``s/2``, about three
-contacts per disc, as in a jammed packing.
+:func:`core_table` (cost of one NLGS contact update, numba against the same loop in plain
+C on the same packed arrays, ``c_sweep.c``, which must give the same impulses bit for bit;
+detection, step preparation, time per step, peak memory), :func:`sweeps_table` (sweeps to
+a fixed tolerance against N), :func:`ensemble_table` (1 against 2 threads, bit-for-bit
+equal), :func:`startup` and :func:`rule_times` (every pipeline rule's ``benchmark:`` file).
+The packing is a jittered triangular lattice in a box whose neighbours overlap slightly,
+about three contacts per disc, as in a jammed packing.
 """
 import hashlib
 import os

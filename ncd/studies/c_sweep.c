@@ -1,4 +1,5 @@
-/* The NLGS sweep of ncd (ncd/nlgs.py: _sweep_discs, solve_single_contact) in
+/* The NLGS sweep of ncd (ncd/solver/kernels.py: sweep_discs;
+ * ncd/solver/single_contact.py: solve_single_contact) in
  * plain C, on the same packed arrays, as the hardware reference of
  * ncd/studies/bench.py (nlgs_sweep_cost).  Input: a raw file written by ncd.studies.bench
  *   int64 n, n_body, sweeps; int64 order[n]; int32 pair[n][2];

@@ -1,7 +1,8 @@
 """Time to tolerance of one step problem: plain NLGS, NLGS + finishing stage,
-Anderson-accelerated NLGS (:mod:`ncd.solver.anderson`) and both with local exact solves where
-the residual stalls (:mod:`ncd.solver.local_exact`) side by side (issue 13, item 2; the
-benchmark ``bench_tolerance``).  Measurements, not tests."""
+Anderson-accelerated NLGS (:mod:`ncd.solver.anderson`) and both with local exact solves
+where the residual stalls (:mod:`ncd.solver.local_exact`), side by side (the benchmark
+``bench_tolerance``).  Measurements, not tests.
+"""
 import time
 
 import numpy as np

@@ -1,30 +1,12 @@
 """ncd side by side with pymunk (Chipmunk2D in C, sequential impulses) on one poured pile.
 
-Both engines get the same scene and the same work per step:
-
-* a rough ground of ``ground_width`` touching fixed discs (diameter ``d``, the
-  mean diameter, centres on ``y = 0``) between two vertical walls at its ends;
-* ``n_discs`` mobile discs, diameters uniform in ``[d_min, d_max]`` with
-  ``d_max / d_min = size_ratio`` and mean ``d``, mass ``density pi r^2``,
-  moment ``m r^2 / 2``, drawn once from ``default_rng((0, root_seed))``;
-* released one at a time, at rest, every ``drop_every`` steps, at
-  ``x = jitter`` (uniform in ``+-1e-3 d``, same generator) and ``y = top + d_max``
-  where ``top`` is the highest point of any mobile disc (the ground top before the
-  first): a new disc never overlaps another; ``settle`` seconds after the last.
-  Unless ``drop_every h >= sqrt(2 (r_max + d_max) / g)`` (0.061 s by default) a disc
-  has not fallen clear when the next is released, and the source climbs;
-* restitution 0, friction ``mu`` on every pair (Chipmunk multiplies the two
-  shapes' coefficients: each shape gets ``sqrt(mu)``), gravity ``-gravity`` along y;
-* ``iterations`` Gauss-Seidel sweeps per step from the previous step's impulses:
-  ``space.iterations`` in Chipmunk, exactly ``iterations`` NLGS sweeps in ncd
-  (``tol = 1e-300``, ``max_sweeps = check_every = iterations``).
-
-Chipmunk also corrects positions: overlaps beyond ``collision_slop`` (default 0.1
-length units, ten diameters of 1 cm discs in SI) are pushed out by bias velocities
-that remove a fraction ``1 - collision_bias ** h`` per step (default: 10 % per
-1/60 s step), a Baumgarte-like correction that ncd does not do.  Here
-``collision_slop = 1e-3 d``.  Only the step calls are timed (``ncd.step`` against
-``space.step``), in the same process.
+Both engines get the same scene (a rough ground between two walls, discs drawn once and
+released one at a time at rest above the top of the pile, restitution 0, friction ``mu``)
+and the same work per step: ``iterations`` Gauss-Seidel sweeps from the previous step's
+impulses (``space.iterations`` in Chipmunk; exactly that many NLGS sweeps in ncd).
+Chipmunk multiplies the two shapes' friction coefficients, so each gets ``sqrt(mu)``;
+its Baumgarte-like position correction, which ncd does not do, is limited by a small
+``collision_slop``.  Only the step calls are timed, in the same process.
 """
 import time
 
@@ -321,18 +303,10 @@ VARIABLES = {   # name: (units, long_name)
 def compare(cfg, log=None):
     """Pour the same pile with ncd and pymunk; returns an :class:`xarray.Dataset`.
 
-    ``cfg`` (missing keys take :data:`DEFAULTS`; unknown keys, non-positive values,
-    ``size_ratio < 1`` or ``ground_width < 2`` raise :class:`InputError`):
-    ``n_discs`` mobile discs; ``diameter`` their mean d (m), also the ground discs';
-    ``size_ratio`` d_max / d_min; ``density`` (kg/m^2); ``gravity`` (m/s^2, along -y);
-    ``mu`` friction of every pair; ``h`` time step (s); ``iterations`` sweeps per
-    step; ``drop_every`` steps between releases; ``settle`` seconds simulated after
-    the last release; ``ground_width`` ground length in d; ``root_seed`` (>= 0).
-
-    Variables along ``engine = ["ncd", "pymunk"]``: :data:`VARIABLES`, and per disc
-    ``x, y`` (final), ``mass, moment, radius_built`` (read back from each engine);
-    ``radius`` as drawn.  ``log``: a :class:`logging.Logger` for progress.
-    """
+    ``cfg`` keys as :data:`DEFAULTS` (missing keys take the default; unknown keys or bad
+    values raise :class:`InputError`).  Variables along ``engine = ["ncd", "pymunk"]``:
+    :data:`VARIABLES`, and per disc ``x, y``, ``mass, moment, radius_built`` read back from
+    each engine and ``radius`` as drawn.  ``log``: a :class:`logging.Logger` for progress."""
     import pymunk
     cfg = check_cfg(cfg)
     geo = build(cfg)

@@ -1,19 +1,12 @@
 """Stability of Contact Dynamics (CD) and of the soft-contact baseline (MD) on stiff and
-extreme cases (issue 5; Moreau 2005, section 2: the implicit CD step "secures numerical
-stability, allowing one to use considerably larger step-lengths than in MD methods").
+extreme cases (Moreau 2005, section 2: the implicit CD step "secures numerical stability,
+allowing one to use considerably larger step-lengths than in MD methods").
 
-Each case is a small scene (:mod:`ncd.studies.scenes`) run for ``duration`` by CD at
-every ``h`` of its list (theta = 1/2, warm-started NLGS) and by MD at ``h = f h_crit``
-for every factor ``f``, ``h_crit = 2 / omega``, ``omega = sqrt(k_n / m_min)``.  The MD
-stiffness gives an overlap of ``md_overlap`` radii under the case's load ``F``:
-``k_n = F / (md_overlap r)`` for a static load, ``k_n = m v^2 / (md_overlap r)^2`` for an
-impact at speed ``v`` (energy ``m v^2 / 2 = k_n delta^2 / 2``).
-
-Per run: energy ``E = E_kin + E_grav (+ E_spring for MD)``, drift ``(E_end - E_0) / E_s``
-and growth ``max_t (E - E_0) / E_s`` with ``E_s = E_kin,0 + M |g| d`` (d: mean diameter);
-largest interpenetration over the smallest radius; NLGS sweeps and residual; divergence
-(non-finite state or speed above ``speed_factor`` times the case's speed scale) with its
-step; ``stable`` = not diverged and growth <= ``energy_tolerance``.
+Each small case (:mod:`ncd.studies.scenes`) runs by CD at every ``h`` of its list and by
+MD at ``h = f h_crit``, ``h_crit = 2 sqrt(m_min / k_n)``, with ``k_n`` chosen for an overlap
+of ``md_overlap`` radii under the case's load.  Per run: energy drift and growth, largest
+interpenetration, NLGS sweeps, divergence; ``stable`` = not diverged and growth within
+``energy_tolerance``.
 """
 import time
 

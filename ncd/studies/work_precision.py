@@ -1,30 +1,12 @@
-"""Work-precision: error against run time for the NLGS at one step and for time
-integration, Contact Dynamics (CD) against the soft-contact baseline (MD, :mod:`ncd.dynamics.md`).
+"""Work-precision: error against run time, Contact Dynamics (CD) against the soft-contact
+baseline (MD, :mod:`ncd.dynamics.md`).
 
-NLGS at one step (Moreau 2005, section 2: "reviewing contacts cyclically again and
-again ... until some convergence criterium is met", from a zero or a warm initial
-guess).  On the core problem ``U = W s + q`` of one step of a state built here, each
-setting (initial guess, stopping criterion, tolerance) gives a run with its wall time
-(best of ``repeats``), sweeps, relative natural-map residual
-``|s - proj_K(s - rho U~)| / max(|s|, |rho q|)`` (:mod:`ncd.solver.nlgs`) and its distance to
-the limit of the same iteration run to ``reference.tol``:
-
-    err_s = |s - s*| / |s*|,   err_u = max |u_f - u_f*| / (|g| h)   (spins times radii).
-
-Time integration: an observable with a known value against wall time, for CD over
-``h`` and for MD over ``h = f h_crit(k)`` and stiffness ``k = c k_0`` (``k_0`` gives an
-overlap ``md_overlap`` radii under the load):
-
-* incline (tilted gravity, one disc from rest): distance ``x(T) = a T^2 / 2`` with
-  ``a = g (sin a - mu cos a)`` (sliding, ``mu < tan a / 3``) or ``a = 2/3 g sin a``
-  (rolling);
-* settled heap: vertical reaction of walls on the discs ``R`` against the weight
-  ``W`` (``R / W - 1``; CD: from the momentum balance of the last step,
-  ``R = sum m (u_f - u_i) / h - sum m g``), and packing fraction
-  ``phi = sum pi r^2 / (width * top)`` against the finest CD run (no closed form);
-* slope flow: mean velocity along the slope at time ``T`` against CD at
-  ``h_reference`` with a tight tolerance; CD at ``h_reference / 2`` measures how far
-  that reference itself is from convergence (a granular flow is chaotic).
+NLGS at one step (Moreau 2005, section 2): on the core problem of one step, each setting
+(initial guess, stopping criterion, tolerance) gives a wall time, sweeps, the natural-map
+residual and the distance to the limit of the same iteration run to ``reference.tol``.
+Time integration: an observable with a known value against wall time, for CD over ``h``
+and MD over ``h`` and stiffness: an incline (closed form, sliding or rolling), a settled
+heap (wall reaction against the weight) and a slope flow (against a fine CD reference).
 """
 import time
 
@@ -68,13 +50,12 @@ ANDERSON_MEMORY = 20      # criterion "anderson": Anderson-accelerated NLGS (ncd
 
 
 def nlgs_work_precision(s, h, tols, inits, criteria, reference, repeats, max_sweeps):
-    """All settings on the core problem of the next step of ``s``; a Dataset with
-    dimensions ``(init, criterion, tol)``.
-    Criterion ``"finish"``: NLGS to ``max(tol, FINISH_HANDOFF)``, then the finishing stage
-    (:mod:`ncd.solver.finish`: NLGS while its rate is good, else the projection on its statuses'
-    polyhedron) to ``tol``.  Criterion ``"anderson"``: Anderson-accelerated NLGS
-    (:mod:`ncd.solver.anderson`, memory :data:`ANDERSON_MEMORY`) to ``tol`` on the residual;
-    ``"anderson_local"``: the same with local exact solves where it stalls (:mod:`ncd.solver.local_exact`)."""
+    """All settings on the core problem of the next step of ``s``; a Dataset over ``(init, criterion, tol)``.
+
+    ``"finish"``: NLGS to ``max(tol, FINISH_HANDOFF)``, then :mod:`ncd.solver.finish` to ``tol``;
+    ``"anderson"``: Anderson-accelerated NLGS (:mod:`ncd.solver.anderson`, memory
+    :data:`ANDERSON_MEMORY`); ``"anderson_local"``: the same with local exact solves where
+    it stalls (:mod:`ncd.solver.local_exact`)."""
     problem = prepare_step(s, h)
     guesses = {init: initial_guess(s, problem, init) for init in inits}
     ref_settings = SolverSettings(tol=reference["tol"], max_sweeps=reference["max_sweeps"])

@@ -1,4 +1,4 @@
-# Benchmark suite (issue 6): `snakemake -j2 bench`, not part of the default target.
+# Benchmark suite: `snakemake -j2 bench`, not part of the default target.
 #   core      ns per contact update (numba and the same loop in C), detection,
 #             time per step and memory on dense packings       -> results/bench/core.nc
 #   sweeps    sweeps to a fixed tolerance against N             -> results/bench/sweeps.nc

@@ -1,4 +1,4 @@
-# Work-precision diagrams (issue 5): NLGS at one step on states built here, and time
+# Work-precision diagrams: NLGS at one step on states built here, and time
 # integration (incline, settled heap, slope flow), Contact Dynamics against MD.
 FIG = "error_vs_runtime"
 CFG = section(FIG)

@@ -1,4 +1,4 @@
-# ParaView and animation output (ncd/export.py): `snakemake -j2 export`, not part of the
+# ParaView and animation output (ncd/io/export.py): `snakemake -j2 export`, not part of the
 # default target.  For each figure whose data file stores frames (fig2_slope: the flow,
 # every `flow.snapshot_every` steps; fig4_pile: the pile's construction, every
 # `construction.frame_every` steps, with the ground discs in <name>_ground.vtu; fig4_history:

@@ -1,4 +1,4 @@
-# Issue 16: Figure 4's claims as statistics over piles of two construction histories.
+# Figure 4's claims as statistics over piles of two construction histories.
 #   construct  one pile (history point or rain, member m, n grains); a rain pile reads the
 #              point pile of its member (the rain falls over that pile's base width);
 #              checkpoints in results/fig4_history/checkpoints (resumed after a kill,

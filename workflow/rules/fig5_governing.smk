@@ -1,10 +1,10 @@
-# Figure 5 (issue 15): what governs indeterminacy — static packings across friction,
+# Figure 5: what governs indeterminacy — static packings across friction,
 # measured exactly (LPs on A ∩ C) and Unger, Kertész & Wolf's way (noise + NLGS).
 #   pack      packings of one shard built by contact dynamics  -> shards/packs_<k>-of-<n>.nc
 #   exact     exact measures of A ∩ C (HiGHS LPs)              -> shards/exact_<k>-of-<n>.nc
 #   unger     noise + NLGS relaxations (exploration)           -> shards/unger_<k>-of-<n>.nc
 #   merge     every shard of the three                         -> packings.nc
-#   deposit, flow, flows (below): the flows of items 2-3       -> flows.nc
+#   deposit, flow, flows (below): Figure 2's flow across mu, h, slope  -> flows.nc
 #   notebook  notebooks/fig5_governing.ipynb                    -> results/figures/fig5_governing.png|pdf
 FIG = "fig5_governing"
 CFG = section(FIG)
@@ -116,7 +116,7 @@ rule fig5_governing:
         figure_targets(FIG),
 
 
-# Flows (items 2-3 of issue 15): Figure 2's flow across mu, h and slope, one factor at a
+# Flows: Figure 2's flow across mu, h and slope, one factor at a
 # time around Figure 2's setting; scans of distinct solutions and why a line.
 #   deposit   one deposit per seed (at the base mu), shared by every setting -> shards/deposit_seed<s>.nc
 #   flow      one flow per (setting, seed), scanned                       -> shards/flow_<i>_seed<s>.nc

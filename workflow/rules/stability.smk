@@ -1,4 +1,4 @@
-# Stability of Contact Dynamics and of the MD baseline on stiff and extreme cases (issue 5).
+# Stability of Contact Dynamics and of the MD baseline on stiff and extreme cases.
 # One job runs every case (small scenes; a job's start-up costs more than most cases).
 FIG = "stability"
 CFG = section(FIG)

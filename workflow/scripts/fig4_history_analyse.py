@@ -1,4 +1,4 @@
-"""Issue 16: ground stress, dip and arching over the piles of both histories (analysis_n<n>.nc)."""
+"""Figure 4 over construction histories: ground stress, dip and arching over the piles (analysis_n<n>.nc)."""
 import xarray as xr
 
 from ncd.figures import history_analysis

@@ -1,4 +1,4 @@
-"""Issue 16: build one pile of one history (checkpointed), write its file with frames."""
+"""Figure 4 over construction histories: build one pile of one history (checkpointed), write its file with frames."""
 import os
 
 import xarray as xr

@@ -1,4 +1,4 @@
-"""Issue 16: exact angle ranges over A ∩ C at the arching cuts of one pile (HiGHS LPs)."""
+"""Figure 4 over construction histories: exact angle ranges over A ∩ C at the arching cuts of one pile (HiGHS LPs)."""
 import xarray as xr
 
 from ncd.figures import history_exact

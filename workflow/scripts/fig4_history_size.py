@@ -1,4 +1,4 @@
-"""Issue 16, item 4: the analyses of every pile size side by side (size.nc)."""
+"""Figure 4 over construction histories, size study: the analyses of every pile size side by side (size.nc)."""
 import xarray as xr
 
 from ncd.figures import history_size
