@@ -110,30 +110,21 @@ def solve_local(W, q, mu, guess=None, review_order=None, settings=SolverSettings
     ``W`` is (2n, 2n), dense or scipy.sparse, rows ordered (n_1, t_1, n_2, ...);
     ``q`` (2n,); ``mu`` scalar or (n,).  Checks: :func:`check_local_problem`.
     """
-    W, q, mu, guess, review_order = check_local_problem(W, q, mu, guess, review_order, settings)
+    # checked once, returned in the form the kernel reads: Wc CSR, q flat, mu (n,), guess (n, 2), order int64
+    Wc, q, mu, guess, order = check_local_problem(W, q, mu, guess, review_order, settings)
     if settings.accel != "none":
         raise InputError(f"settings.accel = {settings.accel!r}: acceleration is implemented "
-                                "for the disc form (solve_discs, solve_problem) only")
+                         "for the disc form (solve_discs, solve_problem) only")
     if settings.local_exact:
         raise InputError("settings.local_exact = True: local exact solves are implemented "
-                                "for the disc form (solve_discs, solve_problem) only")
+                         "for the disc form (solve_discs, solve_problem) only")
     if len(q) == 0:
         return NLGSResult(np.zeros((0, 2)), np.zeros(0, np.int8), 0, 0.0, 0.0, True)
-    Wc = sp.csr_matrix(W, dtype=float)
-    q = np.asarray(q, dtype=float).ravel()
     n = len(q) // 2
-    if Wc.shape != (2 * n, 2 * n) or len(q) != 2 * n:
-        raise ValueError(f"W has shape {Wc.shape}, q has length {len(q)}: expected (2n, 2n) and 2n")
-    mu = np.broadcast_to(np.asarray(mu, dtype=float), (n,)).copy()
-    if np.any(mu < 0):
-        raise ValueError(f"mu must be >= 0; got min {mu.min()}")
-    Wd = np.empty((n, 2, 2))
+    Wd = np.empty((n, 2, 2))                  # the diagonal blocks (positive definite: checked)
     for i, j in ((0, 0), (0, 1), (1, 0), (1, 1)):
         Wd[:, i, j] = Wc[np.arange(n) * 2 + i, np.arange(n) * 2 + j].A1
-    if np.any(Wd[:, 0, 0] <= 0) or np.any(Wd[:, 0, 0] * Wd[:, 1, 1] - Wd[:, 0, 1] * Wd[:, 1, 0] <= 0):
-        raise ValueError("the diagonal 2x2 blocks of W must be positive definite")
-    flat = np.zeros(2 * n) if guess is None else np.array(guess, dtype=float).ravel().copy()
-    order = np.arange(n) if review_order is None else np.asarray(review_order, dtype=np.int64)
+    flat = guess.reshape(-1).copy()
     status = np.zeros(n, np.int8)
     data = (Wc.indptr.astype(np.int64), Wc.indices.astype(np.int64), Wc.data, q, Wd, mu, flat)
     result = run_nlgs(iterate_local, data, order, status, problem_scale(q.reshape(n, 2), Wd), settings)
