@@ -17,6 +17,7 @@ tangential per mobile disc).
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.sparse as sp
 
 from ncd.core.detection import check_detection_args, disc_pairs
 from ncd.core.errors import InputError
@@ -207,7 +208,6 @@ def h_matrix(scene, contacts):
     contact ``alpha``.  ``H^T u`` is the local velocity, ``H^T M^-1 H`` the
     Delassus matrix, ``H s + h F = 0`` the equilibrium of every mobile disc.
     """
-    import scipy.sparse as sp
     c = contacts
     nm = scene.n_mobile
     t = c.tangent

@@ -14,6 +14,8 @@ Each type's own checks live beside it: Scene in :mod:`ncd.core.model`, Contacts 
 ``W`` in :mod:`ncd.solver.nlgs`, steps in :mod:`ncd.dynamics.stepper`, ensembles in
 :mod:`ncd.dynamics.explore`.
 """
+import functools
+import inspect
 import numbers
 
 import numpy as np
@@ -207,8 +209,6 @@ def all_finite(a):
 def finite_output(func):
     """Decorator of the NLGS entry points: a result (or, in disc form, ``vel`` and
     ``spin`` modified in place) that is not finite raises :class:`ncd.SimulationError`."""
-    import functools
-    import inspect
     signature = inspect.signature(func)
 
     @functools.wraps(func)
@@ -237,7 +237,6 @@ def finite_problem(func):
     """Decorator of :func:`ncd.prepare_step`: a problem whose free velocities, Delassus
     blocks or bias overflowed (e.g. ``h * g`` beyond double precision) raises
     :class:`ncd.SimulationError` instead of being returned."""
-    import functools
 
     @functools.wraps(func)
     def checked(*args, **kwargs):
@@ -251,7 +250,6 @@ def finite_problem(func):
 
 def finite_value(func):
     """Decorator: a NaN or infinite float returned (an overflow) raises :class:`ncd.SimulationError`."""
-    import functools
 
     @functools.wraps(func)
     def checked(*args, **kwargs):

@@ -12,6 +12,7 @@ import time
 
 import numpy as np
 import xarray as xr
+import yaml
 
 from ncd.dynamics.explore import explore
 from ncd.dynamics.stepper import prepare_step, solve_problem
@@ -308,5 +309,4 @@ def census_text(ds):
 
 def yaml_safe(attrs, key, default):
     """A census config value from the provenance YAML of census.nc."""
-    import yaml
     return yaml.safe_load(attrs.get("config_yaml", "{}")).get(key, default)

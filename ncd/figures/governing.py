@@ -10,6 +10,7 @@ then run until the equilibrium test of section 2 passes and every disc is slow.
 """
 import numpy as np
 import xarray as xr
+from scipy import stats
 
 from ncd.core.contacts import h_matrix, match_warm
 from ncd.core.errors import InputError
@@ -305,7 +306,6 @@ def merge(pack_paths, exact_paths, unger_paths):
 
 def eta_table(ds, var="eta_exact", kind=0):
     """Per mu: mean, 95 % band (t-interval over packings), count of ``var`` for ``kind``."""
-    from scipy import stats
     sel = ds.kind.values == kind
     rows = []
     for i in np.unique(ds.mu_index.values[sel]):

@@ -6,6 +6,7 @@ over seeds) and :func:`line_counts` (cloud ranks and how often the cluster hypot
 :mod:`ncd.figures.governing_line` holds).
 """
 import numpy as np
+from scipy import stats
 
 from ncd.figures.governing_flow import FACTORS
 
@@ -30,7 +31,6 @@ def flow_measures(ds):
 
 
 def _band(v):
-    from scipy import stats
     v = v[np.isfinite(v)]
     if len(v) == 0:
         return np.nan, np.nan, 0

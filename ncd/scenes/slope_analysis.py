@@ -12,6 +12,7 @@ import itertools
 
 import numpy as np
 import xarray as xr
+import yaml
 
 from ncd.io.netcdf import provenance
 
@@ -290,7 +291,6 @@ def cloud_against_census(ens, census, grain, init="zero"):
     none).  The cloud's principal axes differ from those of its solutions by at most the RMS
     iteration error (singular values are 1-Lipschitz), so the cloud is a set of solutions
     blurred by that error.  Returns counts and axes (m s-2)."""
-    import yaml
     tight = ens.sel(init=init).isel(tol=-1)
     ok = tight.converged.values.astype(bool)
     g = float(census.attrs["g"])

@@ -10,6 +10,7 @@ about three contacts per disc, as in a jammed packing.
 """
 import hashlib
 import os
+import platform
 import shutil
 import subprocess
 import sys
@@ -17,6 +18,7 @@ import tempfile
 import time
 from pathlib import Path
 
+import numba
 import numpy as np
 import xarray as xr
 
@@ -308,9 +310,6 @@ def ensemble_table(cfg, log=None):
 
 def environment():
     """Machine and library versions, as dataset attributes."""
-    import platform
-
-    import numba
     return {"python": platform.python_version(), "numpy": np.__version__, "numba": numba.__version__,
             "machine": platform.machine(), "cpu_count": os.cpu_count(),
             "numba_threads": numba.get_num_threads(), "loadavg_start": os.getloadavg()[0]}
