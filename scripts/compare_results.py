@@ -31,7 +31,7 @@ from pathlib import Path
 import netCDF4
 import numpy as np
 
-MEASURED = [r"wall_?time", r"wall_?clock", r"time_s(_|$)", r"elapsed", r"seconds", r"runtime", r"duration",
+MEASURED = [r"wall_?time", r"wall_?clock", r"time_s(_|$)", r"elapsed", r"seconds", r"runtime",
             r"_(s|ms|us|ns)$", r"^(s|ms|us|ns)_per_", r"^time_(mean|median|settle|total)$", r"speed_?up",
             r"peak_memory", r"memory_growth", r"(^|_)max_rss", r"cpu_count", r"^machine$"]
 PROVENANCE = [r"^git_commit$"]
