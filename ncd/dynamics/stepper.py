@@ -77,19 +77,11 @@ def _finite(a):
     return True
 
 
-def _check_h_theta(h, theta):
-    if not (np.isfinite(h) and h > 0):
-        raise InputError(f"time step h = {h!r} must be > 0")
-    if not (0.0 < theta <= 1.0):
-        raise InputError(f"theta = {theta!r} must be in (0, 1]")
-
-
 @validate.finite_problem
 def prepare_step(scene, h, theta=0.5, gap_tolerance=None, vel=None, spin=None):
     """Build the core problem of the step from the current state (or ``vel, spin``)."""
     check_scene(scene)
     h, theta = check_step_args(h, theta, gap_tolerance, vel, spin, scene.n_disc)
-    _check_h_theta(h, theta)
     vel = scene.vel if vel is None else vel
     spin = scene.spin if spin is None else spin
     nm = scene.n_mobile
