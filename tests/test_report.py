@@ -132,3 +132,25 @@ def test_run_times_sum_the_benchmark_files(tmp_path):
         (d / f"{name}.tsv").write_text(f"s\th:m:s\tmax_rss\n{s}\t0:00:0{int(s)}\t100\n")
     assert run_times(tmp_path, "fig1_wedged") == (2, 6.5)
     assert run_times(tmp_path, "absent") == (0, 0.0)
+
+
+def test_each_page_states_the_index_verdict(results):
+    """On the run's pages: every claim a figure judges is printed on that figure's page,
+    under the anchor the index links to, with the same verdict and the same value."""
+    import html as html_lib
+
+    wrong = []
+    for c, fig, v in claim_rows(results):
+        if not fig:
+            continue
+        page = results / "html" / f"{fig}.html"
+        text = page.read_text(encoding="utf-8") if page.exists() else ""
+        at = text.find(f'id="{C.anchor(c["id"])}"')
+        if at < 0:
+            wrong.append((c["id"], fig, "no anchor"))
+            continue
+        end = text.find('id="claim-', at + 10)
+        block = html_lib.unescape(re.sub(r"<[^>]+>", "", text[at:end if end > 0 else at + 20000]))
+        if v.verdict not in block or v.value[:60] not in block:
+            wrong.append((c["id"], fig, v.verdict))
+    assert not wrong, wrong
