@@ -306,10 +306,19 @@ def test_lp_vertices_are_admissible_and_the_dip_verdict_follows_the_numbers(data
     assert np.all(ex.kernel_min.values <= ex.kernel_history.values + 1e-6 * ex.attrs["weight"])
     assert np.all(ex.kernel_history.values <= ex.kernel_max.values + 1e-6 * ex.attrs["weight"])
     m = list(ex.choice.values).index(ex.attrs["dip_main_choice"])
-    lo, hi = float(ex.depth_min[m]), float(ex.depth_max[m])
-    assert lo - 1e-6 <= float(ex.depth_history[m]) <= hi + 1e-6
-    geometry = "forced" if hi < 0 else ("excluded" if lo >= 0 else "allowed")
+    lo, hi = float(ex.dip_min[m]), float(ex.dip_max[m])
+    assert lo - 1e-6 <= float(ex.dip_history[m]) <= hi + 1e-6
+    geometry = "forced" if lo > 0 else ("excluded" if hi <= 0 else "allowed")
     assert ex.attrs["dip_geometry"] == geometry
+    # the dip depth: flank minus centre of the kernel pressure (> 0 a dip), in units of W / 2L
+    assert "W/2L" in ex.dip_history.attrs["long_name"] and "> 0 a dip" in ex.dip_history.attrs["long_name"]
+    cuts = data["cuts"]
+    unit = ex.attrs["weight"] / (cuts.attrs["right_toe"] - cuts.attrs["left_toe"])
+    assert abs(ex.attrs["dip_unit"] - unit) <= 1e-9 * unit
+    # the main choice is the kernel of kernel_history: its dip read off that curve (another grid)
+    x, p, a = ex.x_kernel.values, ex.kernel_history.values, ex.attrs["dip_offset"]
+    flank_minus_centre = 0.5 * (np.interp(-a, x, p) + np.interp(a, x, p)) - np.interp(0.0, x, p)
+    assert abs(float(ex.dip_history[m]) - flank_minus_centre / unit) <= 0.01
     # every admissible state arches across a cut exactly when the largest F_y is negative
     assert np.array_equal(ex.all_arch.values.astype(bool), ex.fy_max.values < 0)
 

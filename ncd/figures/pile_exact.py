@@ -101,6 +101,9 @@ def exact_dataset(cfg, construction, cuts, log=None):
     # the dip: depth per analysis choice, history values, exact ranges
     labels, D = pm.sensitivity_rows(c, nm, d, ex["dip_offset_d"] * d, ex["kernel_widths_d"],
                                     ex["bin_widths_d"], ex["bin_shifts"])
+    # in units of the mean ground stress W / 2L (2L: toe to toe), as the history piles' dip
+    mean_stress = weight / (float(cuts.attrs["right_toe"]) - float(cuts.attrs["left_toe"]))
+    D = (D / mean_stress).tocsr()
     depth_hist = D @ history
     depth_band = es.intervals(D)
     main = labels.index(f"kernel {ex['kernel_d']:g} d")
@@ -144,9 +147,9 @@ def exact_dataset(cfg, construction, cuts, log=None):
             "kernel_max": ("x_kernel", band_kernel[:, 1], {"units": "N m-1", "long_name": "exact maximum of the kernel ground pressure over A ∩ C"}),
             "kernel_history": ("x_kernel", K @ history, {"units": "N m-1", "long_name": "kernel ground pressure of the history forces"}),
             "choice": ("choice", np.array(labels), {"units": "1", "long_name": "ground-pressure estimate (kernel width, or bin width and shift)"}),
-            "depth_history": ("choice", depth_hist, {"units": "N m-1", "long_name": "dip depth p(0) - (p(-a) + p(a))/2 of the history forces"}),
-            "depth_min": ("choice", depth_band[:, 0], {"units": "N m-1", "long_name": "exact minimum of the dip depth over A ∩ C"}),
-            "depth_max": ("choice", depth_band[:, 1], {"units": "N m-1", "long_name": "exact maximum of the dip depth over A ∩ C"}),
+            "dip_history": ("choice", depth_hist, {"units": "1", "long_name": "dip depth (p(-a) + p(a))/2 - p(0) of the history forces, in units of the mean ground stress W/2L (> 0 a dip, < 0 a hump)"}),
+            "dip_min": ("choice", depth_band[:, 0], {"units": "1", "long_name": "exact minimum over A ∩ C of the dip depth (units of W/2L, > 0 a dip)"}),
+            "dip_max": ("choice", depth_band[:, 1], {"units": "1", "long_name": "exact maximum over A ∩ C of the dip depth (units of W/2L, > 0 a dip)"}),
         },
         coords={"cut": cuts["cut"].values, "vertex": np.arange(width), "bin": cuts["bin"].values,
                 "x_kernel": xg},
@@ -154,7 +157,7 @@ def exact_dataset(cfg, construction, cuts, log=None):
                          vertex_equilibrium=vertex_check[0], vertex_coulomb=vertex_check[1],
                          vertex_refinement=vertex_shift,
                          dip_geometry=geometry, dip_called=called, dip_binning_spread=spread,
-                         dip_main_choice=labels[main], dip_offset=ex["dip_offset_d"] * d,
+                         dip_main_choice=labels[main], dip_offset=ex["dip_offset_d"] * d, dip_unit=mean_stress,
                          kernel_width=ex["kernel_d"] * d, n_lp_total=es.n_lp,
                          polygon_angle_gap=polygon_angle_gap),
     )
@@ -222,14 +225,22 @@ def exact_text(exact, ens, cuts):
                  f"linear-fractional program: {int(np.median(exact.angle_n_lp.values))} LPs per cut on median, "
                  f"certified to {np.nanmax(exact.angle_bound.values):.0e}°; on the three polygons the ranges agree "
                  f"with the polygons' own to {a['polygon_angle_gap']:.0e}°).")
-    m = list(exact.choice.values).index(a["dip_main_choice"])
-    lines.append(f"Ground pressure ({a['dip_main_choice']}): dip depth p(0) - (p(-a)+p(a))/2 with "
-                 f"a = {a['dip_offset'] * 1e3:.1f} mm is {float(exact.depth_history[m]):.1f} N/m for the history "
-                 f"forces; over the analysis choices it spans {a['dip_binning_spread']:.1f} N/m; over A ∩ C it "
-                 f"ranges exactly from {float(exact.depth_min[m]):.1f} to {float(exact.depth_max[m]):.1f} N/m: a dip "
-                 f"is **{a['dip_geometry']}** by the geometry, and "
-                 f"{'a dip is called' if a['dip_called'] else 'no dip is called'}.")
+    lines.append(dip_sentence(exact))
     return "\n\n".join(lines)
+
+
+def dip_sentence(exact):
+    """The ground-pressure dip of ``exact.nc`` in one sentence: the dip depth (flank minus
+    centre, > 0 a dip, in units of the mean ground stress W/2L as on the history page), its
+    spread over the analysis choices, its exact range over A ∩ C and the verdict."""
+    a = exact.attrs
+    m = list(exact.choice.values).index(a["dip_main_choice"])
+    return (f"Ground pressure ({a['dip_main_choice']}): the dip depth (p(−a) + p(a))/2 − p(0) with "
+            f"a = {a['dip_offset'] * 1e3:.1f} mm, in units of the mean ground stress W/2L = {a['dip_unit']:.0f} N/m "
+            f"(> 0 a dip, < 0 a hump), is {float(exact.dip_history[m]):+.3f} for the history forces; over the "
+            f"analysis choices it spans {a['dip_binning_spread']:.3f}; over A ∩ C it ranges exactly from "
+            f"{float(exact.dip_min[m]):+.3f} to {float(exact.dip_max[m]):+.3f}: a dip is **{a['dip_geometry']}** by "
+            f"the geometry, and {'a dip is called' if a['dip_called'] else 'no dip is called'}.")
 
 
 def diameter(v):
