@@ -19,7 +19,7 @@ from ncd.scenes import cuts as cm
 from ncd.scenes import pressure as pm
 from ncd.scenes.pile import cut_specs, pile_problem
 from ncd.scenes.sources import mean_diameter
-from ncd.solver.convergence import OUTCOMES, REST
+from ncd.solver.convergence import REST
 
 __all__ = ["ExactSet", "exact_dataset", "pile_problem", "resultant_angle"]
 
@@ -188,59 +188,6 @@ def cloud_in_polygon(exact, ens, k, mask):
     out = outside_distance(P, poly) if len(P) else np.zeros(0)
     area = float(exact.polygon_area.values[k])
     return P, out, (hull_area(P) / area if area > 0 and len(P) >= 3 else 0.0)
-
-
-def draw_cloud(ax, exact, ens, k, mask, color="C0", label=None):
-    """The exact polygon of cut ``k`` (shaded) and the converged rest runs (dots)."""
-    poly = polygon_of(exact, k)
-    ax.fill(*np.vstack([poly, poly[:1]]).T, color="0.85", lw=0.8, ec="0.4", label="exact projection of A ∩ C")
-    P, _, _ = cloud_in_polygon(exact, ens, k, mask)
-    ax.plot(P[:, 0], P[:, 1], ".", ms=2, color=color, label=label)
-    ax.set(xlabel="$F_x$ (N)", ylabel="$F_y$ (N)")
-    ax.set_aspect("equal", adjustable="datalim")
-
-
-def exact_text(exact, ens, cuts):
-    """Markdown from exact.nc and the ensemble: outcomes, polygons and coverage of the
-    default and shifted cuts, arching over all cuts, the ground-pressure dip verdict."""
-    a, W = exact.attrs, float(exact.attrs["weight"])
-    oc = ens["outcome"].values
-    counts = {OUTCOMES[k]: int((oc == k).sum()) for k in sorted(OUTCOMES)}
-    mask = oc == 1
-    lines = [f"Of the {len(oc)} zero-guess runs, {counts['rest']} converged at rest, {counts['motion']} converged "
-             f"on a motion solution (grains moving faster than the rest bound) and {counts['unconverged']} did "
-             f"not converge; only the {counts['rest']} rest states are drawn."]
-    for k, name in ((0, "default"), (1, "moved by -1 d"), (2, "moved by +1 d")):
-        P, out, cov = cloud_in_polygon(exact, ens, k, mask)
-        lines.append(f"Cut {name}: exact polygon of {int(exact.n_vertices[k])} vertices ({int(exact.n_lp[k])} LPs), "
-                     f"diameter {diameter(polygon_of(exact, k)):.4f} N; the rest runs cover "
-                     f"{100 * cov:.2g} % of its area and lie inside it to "
-                     f"{(out.max() if len(out) else 0.0) / W:.1e} of the weight.")
-    arch = exact.all_arch.values.astype(bool)
-    lines.append(f"Every admissible force state arches (pushes the bank downward) across {arch.sum()} of the "
-                 f"{len(arch)} cuts; the exact angle of the resultant below the horizontal spans "
-                 f"{np.nanmin(exact.angle_max.values - exact.angle_min.values):.1f}° to "
-                 f"{np.nanmax(exact.angle_max.values - exact.angle_min.values):.1f}° (median "
-                 f"{np.nanmedian(exact.angle_max.values - exact.angle_min.values):.1f}°) across a cut (each end a "
-                 f"linear-fractional program: {int(np.median(exact.angle_n_lp.values))} LPs per cut on median, "
-                 f"certified to {np.nanmax(exact.angle_bound.values):.0e}°; on the three polygons the ranges agree "
-                 f"with the polygons' own to {a['polygon_angle_gap']:.0e}°).")
-    lines.append(dip_sentence(exact))
-    return "\n\n".join(lines)
-
-
-def dip_sentence(exact):
-    """The ground-pressure dip of ``exact.nc`` in one sentence: the dip depth (flank minus
-    centre, > 0 a dip, in units of the mean ground stress W/2L as on the history page), its
-    spread over the analysis choices, its exact range over A ∩ C and the verdict."""
-    a = exact.attrs
-    m = list(exact.choice.values).index(a["dip_main_choice"])
-    return (f"Ground pressure ({a['dip_main_choice']}): the dip depth (p(−a) + p(a))/2 − p(0) with "
-            f"a = {a['dip_offset'] * 1e3:.1f} mm, in units of the mean ground stress W/2L = {a['dip_unit']:.0f} N/m "
-            f"(> 0 a dip, < 0 a hump), is {float(exact.dip_history[m]):+.3f} for the history forces; over the "
-            f"analysis choices it spans {a['dip_binning_spread']:.3f}; over A ∩ C it ranges exactly from "
-            f"{float(exact.dip_min[m]):+.3f} to {float(exact.dip_max[m]):+.3f}: a dip is **{a['dip_geometry']}** by "
-            f"the geometry, and {'a dip is called' if a['dip_called'] else 'no dip is called'}.")
 
 
 def diameter(v):
