@@ -43,8 +43,8 @@
 # forces are the history forces. Per pile: the ground stress profile (Gaussian kernel
 # average of the ground-contact forces against $x / L$, $L$ the base half-width of the
 # member's point-source pile from its flank fits, in units of the mean stress $W / 2L$), the dip depth
-# $(M - m)/M$ (central minimum $m$ against the neighbouring maxima $M$; negative: a
-# hump), and the resultant across vertical cuts along both flanks with its angle to
+# $M - m$ in the same unit (the neighbouring maxima $M$ minus the central minimum $m$:
+# $> 0$ a dip, $< 0$ a hump; the dip depth of `fig4_pile` has the same unit and sign), and the resultant across vertical cuts along both flanks with its angle to
 # the pile's own free surface. Bands are bootstrap resamples of the **piles**.
 
 # %%
@@ -52,6 +52,7 @@ import xarray as xr
 from IPython.display import Markdown, display
 
 from ncd.figures import history_plots as hp
+from ncd.pages.notebook import save
 
 try:
     snakemake  # noqa: F821 (injected by Snakemake's notebook directive)
@@ -71,17 +72,16 @@ piles = [xr.load_dataset(inp.point), xr.load_dataset(inp.rain)]
 s = hp.summary(an)
 
 # %%
-fig = hp.figure(an, piles)
-fig.savefig(out.png, dpi=130)
-fig.savefig(out.pdf, metadata={"CreationDate": None})
+save(hp.figure(an, piles), out, dpi=130, show=True)
 
 # %% [markdown]
-# **Top**: member 0 of each history (the same grains). **Bottom left**: mean ground
-# stress over the piles with its 95 % bootstrap band over piles. **Bottom middle**: dip
-# depth of every pile (dots) and of the mean profile with its bootstrap band (bars),
-# for three kernel widths; $p$ is the permutation test of the difference between the
-# histories. **Bottom right**: angle of the cut resultant minus the flank slope,
-# median over piles (bars: bootstrap band of the median; shade: 25–75 % of the piles).
+# **(a)** Member 0 of each history (the same grains). **(b)** Mean ground stress over
+# the piles with its 95 % bootstrap band over piles. **(c)** Dip depth of every pile
+# (dots) and of the mean profile with its basic bootstrap band (bars), for three kernel
+# widths; $p$ is the permutation test of the difference between the histories.
+# **(d)** Angle of the cut resultant minus the flank slope, median over piles (bars:
+# bootstrap band of the median; shade: 25–75 % of the piles; thin lines: the exact
+# range over $A \cap C$ of single piles).
 
 # %%
 P, R = s["point"], s["rain"]
@@ -103,8 +103,8 @@ than the overlap tolerance within one step); why the gentle rain builds a layer 
 a heap was not studied.
 Both histories are drawn against $x / L$ with the $L$ of the member's point-source pile.
 
-**Ground stress ({s['piles']} piles per history, kernel {k:g} d).** Dip depth of the
-mean profile: point source {P['dip']:.3f} (95 % basic bootstrap band over piles {P['lo']:.3f} to {P['hi']:.3f}),
+**Ground stress ({s['piles']} piles per history, kernel {k:g} d).** Dip depth $M - m$ of the
+mean profile, in units of the mean stress $W / 2L$ (> 0 a dip): point source {P['dip']:.3f} (95 % basic bootstrap band over piles {P['lo']:.3f} to {P['hi']:.3f}),
 rain {R['dip']:.3f} ({R['lo']:.3f} to {R['hi']:.3f}); {100 * P['frac_dip']:.0f} % of the
 point-source piles and {100 * R['frac_dip']:.0f} % of the rained piles have a dip of
 their own. The difference point − rain is {s['diff']:.3f} (band {s['diff_lo']:.3f} to
@@ -116,6 +116,7 @@ A single pile's dip is a minimum of a noisy curve against maxima of the same cur
 is biased upwards when the kernel is narrow: the fraction of piles with a dip of their own is
 {', '.join(f"{kk:g} d: {100 * P['frac_by_kernel'][kk]:.0f} % / {100 * R['frac_by_kernel'][kk]:.0f} %" for kk in P['frac_by_kernel'])}
 (point / rain); only the mean profile over piles, with its band, carries a claim.
+{hp.outside_text(an)}
 Under the apex the mean stress is {P['center']:.2f} (point) and {R['center']:.2f} (rain)
 times the mean stress W / 2L.
 

@@ -294,6 +294,22 @@ def test_bands_are_over_piles(analysis, piles, results):
     np.testing.assert_allclose(analysis.ground_fy / analysis.weight, 1.0, atol=WEIGHT_TOL)
 
 
+def test_dip_depth_is_flank_minus_centre_in_units_of_the_mean_stress(analysis):
+    """The label of ``dip_mean``: maxima of the mean profile beside the centre minus its central
+    minimum, in units of W / 2L (the profile's unit), > 0 a dip: the convention of fig4_pile."""
+    a = analysis.attrs
+    xi = analysis.xi.values
+    for h in analysis.history.values:
+        for k in analysis.kernel.values:
+            prof = analysis.profile_mean.sel(history=h, kernel=k).values
+            side = (np.abs(xi) >= a["dip_flank"][0]) & (np.abs(xi) <= a["dip_flank"][1])
+            flank = 0.5 * (prof[side & (xi < 0)].max() + prof[side & (xi > 0)].max())
+            want = flank - prof[np.abs(xi) <= a["dip_center"]].min()
+            assert float(analysis.dip_mean.sel(history=h, kernel=k)) == pytest.approx(want, abs=1e-12)
+    for v in ("dip", "dip_mean"):
+        assert "W/2L" in analysis[v].attrs["long_name"] and "> 0 a dip" in analysis[v].attrs["long_name"]
+
+
 def test_empty_cuts_are_left_out_of_the_arching_statistics(analysis):
     dev, count = analysis.cut_deviation.values, analysis.cut_count.values
     assert np.array_equal(np.isnan(dev), count == 0)

@@ -306,10 +306,19 @@ def test_lp_vertices_are_admissible_and_the_dip_verdict_follows_the_numbers(data
     assert np.all(ex.kernel_min.values <= ex.kernel_history.values + 1e-6 * ex.attrs["weight"])
     assert np.all(ex.kernel_history.values <= ex.kernel_max.values + 1e-6 * ex.attrs["weight"])
     m = list(ex.choice.values).index(ex.attrs["dip_main_choice"])
-    lo, hi = float(ex.depth_min[m]), float(ex.depth_max[m])
-    assert lo - 1e-6 <= float(ex.depth_history[m]) <= hi + 1e-6
-    geometry = "forced" if hi < 0 else ("excluded" if lo >= 0 else "allowed")
+    lo, hi = float(ex.dip_min[m]), float(ex.dip_max[m])
+    assert lo - 1e-6 <= float(ex.dip_history[m]) <= hi + 1e-6
+    geometry = "forced" if lo > 0 else ("excluded" if hi <= 0 else "allowed")
     assert ex.attrs["dip_geometry"] == geometry
+    # the dip depth: flank minus centre of the kernel pressure (> 0 a dip), in units of W / 2L
+    assert "W/2L" in ex.dip_history.attrs["long_name"] and "> 0 a dip" in ex.dip_history.attrs["long_name"]
+    cuts = data["cuts"]
+    unit = ex.attrs["weight"] / (cuts.attrs["right_toe"] - cuts.attrs["left_toe"])
+    assert abs(ex.attrs["dip_unit"] - unit) <= 1e-9 * unit
+    # the main choice is the kernel of kernel_history: its dip read off that curve (another grid)
+    x, p, a = ex.x_kernel.values, ex.kernel_history.values, ex.attrs["dip_offset"]
+    flank_minus_centre = 0.5 * (np.interp(-a, x, p) + np.interp(a, x, p)) - np.interp(0.0, x, p)
+    assert abs(float(ex.dip_history[m]) - flank_minus_centre / unit) <= 0.01
     # every admissible state arches across a cut exactly when the largest F_y is negative
     assert np.array_equal(ex.all_arch.values.astype(bool), ex.fy_max.values < 0)
 
@@ -328,3 +337,57 @@ def test_rest_runs_ground_pressure_lies_in_its_exact_band(data):
     assert np.all(ex.bin_max.values - ex.bin_min.values >= -1e-9 * W / width)
     assert ex.attrs["kernel_width"] == pytest.approx(ex.attrs["mean_diameter"]
                                                      * yaml.safe_load(ex.attrs["config_yaml"])["exact"]["kernel_d"])
+
+
+# ------------------------------------------------------------------ the page (ncd.figures.pile_plots)
+@pytest.fixture(scope="module")
+def page_run(data):
+    from ncd.figures import pile_plots
+
+    cfg = yaml.safe_load(data["cuts"].attrs["config_yaml"])
+    return pile_plots.PileRun(data["construction"], data["cuts"], data["ensemble"], data["exact"], cfg)
+
+
+def test_page_figure_is_legible(page_run):
+    """Four panels lettered once each, no overlapping texts, fonts of at least 9 pt on an 11 in figure."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from ncd.figures import pile_plots
+    from ncd.pages.notebook import MIN_FONT_PT, text_layout
+
+    fig = pile_plots.figure(page_run)
+    letters = [ax.get_title(loc="left")[:3] for ax in fig.axes]
+    assert letters == ["(a)", "(b)", "(c)", "(d)"]
+    lay = text_layout(fig)
+    assert lay["overlaps"] == [] and lay["min_font_pt"] >= MIN_FONT_PT and lay["width_in"] <= 11
+    plt.close(fig)
+
+
+def test_page_sentences_follow_the_data(page_run, data):
+    """The cloud sentence states the diameter of the rest runs' cloud and compares it with the
+    changes of a cut moved by one diameter the way the numbers do; the tolerance study is one
+    sentence when plain NLGS brings too few runs to rest; no sentence prints NaN."""
+    from ncd.figures import pile_plots
+
+    r = page_run
+    P = r.cloud(r.K)
+    text = pile_plots.cloud_text(r)
+    assert f"{int(r.rest.sum())} converged at rest" in text
+    if len(P):
+        D = pile_exact.diameter(P)
+        assert f"spans {D:.3f} N" in text
+        word = "less than" if D < min(r.change) else ("more than" if D > max(r.change) else "between")
+        assert word in text
+    tol = data["tolerance"]
+    tol_text = pile_plots.tolerance_text(r, tol)
+    rest = [int(pile_exact.rest_mask(tol.isel(tol=j)).sum()) for j in range(tol.sizes["tol"])]
+    assert ("too few for a cloud" in tol_text) == (min(rest) < 2)
+    texts = [pile_plots.construction_text(r), pile_plots.arching_text(r), text, tol_text,
+             pile_plots.pressure_text(r), pile_plots.exact_text(data["exact"], data["ensemble"], data["cuts"]),
+             pile_plots.dip_sentence(data["exact"])]
+    assert not [t for t in texts if "nan" in t.lower()]
+    m = list(data["exact"].choice.values).index(data["exact"].attrs["dip_main_choice"])
+    assert f"{float(data['exact'].dip_history[m]):+.3f} for the history forces" in texts[-1]

@@ -117,3 +117,154 @@ def test_folded_table_counts_data_rows_only():
         nb.cells = [cell]
         html = fold_long_tables(nb).cells[0].outputs[0]["data"]["text/html"]
         assert f"table of {n} rows" in html, re.search(r"table of \d+ rows", html)
+
+
+# ---- every page of the run: offline, navigated, legible (chromium) -------------------------------
+PAGES = FIGURES + ("fig4_history", "fig4_history_size", "fig5_governing", "bench")
+# identifiers, never fetched: XML namespaces and the SVG DTD of inline SVG figures
+NAMESPACE = re.compile(r"https?://www\.w3\.org/(2000/svg|1999/xlink|1999/xhtml|Graphics/SVG/1\.1/DTD/svg11\.dtd)")
+PROBE = """<script>window.addEventListener("load", function () {
+  document.querySelectorAll("img").forEach(function (i) {
+    i.setAttribute("data-w", i.getBoundingClientRect().width); i.setAttribute("data-nw", i.naturalWidth); });
+  var n = 0;
+  document.querySelectorAll("svg").forEach(function (svg) {
+    var r = Array.from(svg.querySelectorAll("text")).map(function (t) { return t.getBoundingClientRect(); })
+      .filter(function (b) { return b.width > 0 && b.height > 0; });
+    for (var i = 0; i < r.length; i++) for (var j = i + 1; j < r.length; j++) {
+      var w = Math.min(r[i].right, r[j].right) - Math.max(r[i].left, r[j].left);
+      var h = Math.min(r[i].bottom, r[j].bottom) - Math.max(r[i].top, r[j].top);
+      if (w > 1 && h > 1) n++; } });
+  document.body.setAttribute("data-svg-overlaps", n);
+  document.body.setAttribute("data-probe", "done"); });</script>"""
+
+
+def figure_order():
+    """The FIGURES list of workflow/rules/common.smk (the reading order of the pages)."""
+    from tests.conftest import ROOT
+
+    text = (ROOT / "workflow" / "rules" / "common.smk").read_text()
+    return re.findall(r'"(\w+)"', re.search(r"FIGURES = \[f for f in \((.*?)\)", text, re.S).group(1))
+
+
+def external_urls(html):
+    """Every http(s) URL of a page but the links (``<a href>``, not loaded) and XML namespaces."""
+    soup = BeautifulSoup(html, "html.parser")
+    links = {a["href"] for a in soup.find_all("a", href=True)}
+    urls = re.findall(r"""https?://[^\s"'<>)`\\]+""", html)
+    return sorted({u for u in urls if u not in links and not NAMESPACE.match(u)})
+
+
+def probed_dom(page, tmp_path):
+    """The DOM of ``page`` after chromium laid it out at 1280 px (images' rendered and natural widths)."""
+    probe = page.parent / f".probe_{page.name}"
+    probe.write_text(page.read_text(encoding="utf-8").replace("</body>", PROBE + "</body>", 1), encoding="utf-8")
+    try:
+        out = chromium(probe, "--window-size=1280,2400", "--dump-dom").stdout
+    finally:
+        probe.unlink()
+    dom = BeautifulSoup(out, "html.parser")
+    assert dom.body is not None and dom.body.get("data-probe") == "done", f"{page.name}: the page did not load"
+    return dom
+
+
+def figure_layouts(dom):
+    """(rendered / natural width, text layout) of every PNG of the page saved by ncd.pages.notebook.save."""
+    import base64
+    import io
+    import json
+
+    from PIL import Image
+
+    from ncd.pages.notebook import LAYOUT_KEY
+
+    out = []
+    for img in dom.find_all("img"):
+        src = img.get("src", "")
+        if not src.startswith("data:image/png;base64,") or not img.get("data-nw"):
+            continue
+        meta = Image.open(io.BytesIO(base64.b64decode(src.split(",", 1)[1]))).text
+        if LAYOUT_KEY in meta:
+            out.append((float(img["data-w"]) / float(img["data-nw"]), json.loads(meta[LAYOUT_KEY])))
+    return out
+
+
+def test_external_urls_and_layout_record():
+    """The URL scan sees a CDN import and ignores links and namespaces; ``save`` records overlapping titles."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from ncd.pages.notebook import text_layout
+
+    html = ('<a href="https://hal.science/hal-01824602">paper</a><svg xmlns="http://www.w3.org/2000/svg"></svg>'
+            '<script type="module">import("https://cdn.example.org/m.mjs")</script>')
+    assert external_urls(html) == ["https://cdn.example.org/m.mjs"]
+    fig, ax = plt.subplots(1, 2, figsize=(6, 3))
+    ax[0].set_title("a long title running over the title of the next panel")
+    ax[1].set_title("(b)", fontsize=8, loc="left")
+    lay = text_layout(fig)
+    assert lay["overlaps"] == [["a long title running over the title of t", "(b)"]] and lay["min_font_pt"] == 8
+    ax[1].set_title("")
+    ax[0].set_title("(a)")
+    assert text_layout(fig)["overlaps"] == []
+    plt.close(fig)
+
+
+@pytest.mark.slow
+@pytest.mark.pipeline
+@needs_chromium
+@pytest.mark.parametrize("name", PAGES)
+def test_page_offline_navigated_legible(results, name, tmp_path):
+    """Each page: no external URL, no Out[n] prompt, its human title, a header linking to the
+    index, its neighbours in FIGURES' order (files that exist) and the paper; in chromium, no
+    overlapping texts in its figures (PNG layout records, inline SVG) and fonts of at least
+    MIN_FONT_PT at the size the page shows them."""
+    from ncd.pages.notebook import MIN_FONT_PT
+    from ncd.pages.render import INDEX, PAPER_URL, neighbours, title_of
+
+    page = results / "html" / f"{name}.html"
+    if not page.exists():
+        pytest.skip(f"{name} not built in this run")
+    html = page.read_text(encoding="utf-8")
+    assert external_urls(html) == [], f"{name}: external URLs"
+    soup = BeautifulSoup(html, "html.parser")
+    assert not [p for p in soup.select(".jp-OutputPrompt, .jp-InputPrompt") if "[" in p.get_text()]
+    assert soup.title.get_text() == title_of(name) != name
+    nav = soup.select_one("nav.ncd-nav")
+    assert nav is not None, f"{name}: no navigation header"
+    assert nav.select_one("a.ncd-index")["href"] == INDEX and (page.parent / INDEX).resolve() == results / "index.html"
+    assert nav.select_one("a.ncd-paper")["href"] == PAPER_URL
+    for cls, want in zip(("ncd-prev", "ncd-next"), neighbours(name, figure_order())):
+        a = nav.select_one(f"a.{cls}")
+        assert (a is None) == (want is None), f"{name}: {cls} link"
+        if a is not None:
+            assert a["href"] == f"{want}.html" and (page.parent / a["href"]).exists(), a["href"]
+    dom = probed_dom(page, tmp_path)
+    assert dom.body["data-svg-overlaps"] == "0", f"{name}: overlapping SVG texts"
+    for scale, lay in figure_layouts(dom):
+        assert lay["overlaps"] == [], f"{name}: overlapping texts {lay['overlaps'][:5]}"
+        shown = lay["min_font_pt"] * lay["dpi"] / 96 * min(scale, 1.0) if lay["min_font_pt"] else MIN_FONT_PT
+        assert shown >= MIN_FONT_PT - 0.05, f"{name}: smallest font {shown:.1f} pt at the page's width"
+
+
+def test_neighbours_and_header():
+    """Pages of the list link to their neighbours; a page outside it sits after the page it
+    extends; the header names the pages by their titles and links the paper."""
+    from ncd.pages.render import PAPER_URL, nav_header, neighbours
+
+    order = ["fig1_wedged", "fig4_history", "fig5_governing"]
+    assert neighbours("fig1_wedged", order) == (None, "fig4_history")
+    assert neighbours("fig5_governing", order) == ("fig4_history", None)
+    assert neighbours("fig4_history_size", order) == ("fig4_history", "fig5_governing")
+    assert neighbours("bench", order) == ("fig5_governing", None)
+    nav = BeautifulSoup(nav_header("fig4_history", order), "html.parser")
+    assert nav.select_one("a.ncd-prev").get_text() == "← Figure 1 — a disc wedged between two discs"
+    assert nav.select_one("a.ncd-next").get_text().startswith("Beyond the paper — governing parameters")
+    assert nav.select_one("a.ncd-paper")["href"] == PAPER_URL and nav.select_one("a.ncd-index")["href"] == "../index.html"
+
+
+def test_demo_page_offline_titled(page):
+    html = page.read_text()
+    assert external_urls(html) == [] and "import(" not in html
+    assert BeautifulSoup(html, "html.parser").title.get_text() == "demo"

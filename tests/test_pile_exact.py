@@ -105,11 +105,12 @@ def test_ground_pressure_maps_integrate_to_the_ground_force():
     assert abs((B @ r) @ np.diff(e) - weight) <= 1e-12 * weight
     depth = pm.dip_row(K, x, 4.0) @ r
     p = K @ r
-    ref = np.interp(0.0, x, p) - 0.5 * (np.interp(-4.0, x, p) + np.interp(4.0, x, p))
+    ref = 0.5 * (np.interp(-4.0, x, p) + np.interp(4.0, x, p)) - np.interp(0.0, x, p)   # > 0 a dip
     assert abs(depth[0] - ref) <= 1e-12 * weight
-    assert pm.dip_verdict(-1.0, 0.5, -3.0, -0.2) == ("forced", True)
-    assert pm.dip_verdict(-1.0, 1.5, -3.0, -0.2) == ("forced", False)
-    assert pm.dip_verdict(-1.0, 0.1, -3.0, 0.2) == ("allowed", False)
+    assert pm.dip_verdict(1.0, 0.5, 0.2, 3.0) == ("forced", True)
+    assert pm.dip_verdict(1.0, 1.5, 0.2, 3.0) == ("forced", False)
+    assert pm.dip_verdict(1.0, 0.1, -0.2, 3.0) == ("allowed", False)
+    assert pm.dip_verdict(-1.0, 0.1, -3.0, 0.0) == ("excluded", False)
 
 
 def three_grain_pile(mu):

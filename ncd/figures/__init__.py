@@ -10,7 +10,7 @@ FIGURE_MODULES = {
     "fig1_wedged": ("wedged",),
     "fig2_slope": ("census",),
     "fig3_equilibrium": ("equilibrium", "faces"),
-    "fig4_pile": ("pile", "pile_exact"),
+    "fig4_pile": ("pile", "pile_exact", "pile_plots"),
     "fig4_history": ("history", "history_analysis", "history_exact", "history_plots", "history_size"),
     "fig5_governing": ("governing", "governing_exact", "governing_flow", "governing_line", "governing_plot",
                        "governing_summary"),

@@ -2,7 +2,8 @@
 
 Per pile, from its history forces: the ground stress profile ``p(x / L)`` (kernel
 average of the ground contacts, normalised by the mean stress ``W / (2 L)``), the dip
-depth ``(M - m) / M`` (> 0 a dip under the apex) and the angle of the resultant across
+depth ``M - m`` in units of that mean stress (> 0 a dip under the apex; the name, unit and
+sign of the single pile's dip in :mod:`ncd.scenes.pressure`) and the angle of the resultant across
 vertical cuts at ``x = ± q L`` against the pile's flank slope.  Statistics resample piles,
 never runs of one pile.  The dip is a minimum against maxima of a noisier resampled
 profile, so its percentile band is biased upwards; the dip and difference bands are
@@ -37,14 +38,15 @@ def stress_profile(x, fy, weight, L, xi, width):
 
 
 def dip_depth(profile, xi, center, flank):
-    """``(M - m) / M`` along the last axis: ``m`` the central minimum (``|xi| <= center``),
-    ``M`` the mean of the largest values on either side within ``flank``."""
+    """The dip depth ``M - m`` along the last axis (the profile's unit, W / 2L; > 0 a dip):
+    ``m`` the central minimum (``|xi| <= center``), ``M`` the mean of the largest values on
+    either side within ``flank``."""
     P = np.reshape(profile, (-1, len(xi)))
     a = np.abs(xi)
     m = np.min(P[:, a <= center], axis=1)
     sel = (a >= flank[0]) & (a <= flank[1])
     big = 0.5 * (np.max(P[:, sel & (xi < 0)], axis=1) + np.max(P[:, sel & (xi > 0)], axis=1))
-    return ((big - m) / big).reshape(np.shape(profile)[:-1])
+    return (big - m).reshape(np.shape(profile)[:-1])
 
 
 def norm_length(cfg, ds):
@@ -172,8 +174,8 @@ def ensemble_dataset(cfg, files, exact=None):
                               "bootstrap band over piles of the mean ground stress, lower end"),
             "profile_hi": one((H, K, X), np.quantile(boot_mean, hi, axis=1), "1",
                               "bootstrap band over piles of the mean ground stress, upper end"),
-            "dip": one((H, P, K), dips, "1", "dip depth of one pile's profile (M - m) / M"),
-            "dip_mean": one((H, K), dip_mean, "1", "dip depth of the mean profile (M - m) / M"),
+            "dip": one((H, P, K), dips, "1", "dip depth M - m of one pile's profile (flank maxima minus central minimum), units of the mean ground stress W/2L, > 0 a dip"),
+            "dip_mean": one((H, K), dip_mean, "1", "dip depth M - m of the mean profile over piles, units of the mean ground stress W/2L, > 0 a dip"),
             "dip_lo": one((H, K), dip_lo, "1", "basic bootstrap band over piles of dip_mean, lower"),
             "dip_hi": one((H, K), dip_hi, "1", "basic bootstrap band over piles of dip_mean, upper"),
             "dip_diff": one((K,), dip_mean[0] - dip_mean[-1], "1", f"dip_mean {hist[0]} minus {hist[-1]}"),

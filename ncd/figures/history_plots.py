@@ -1,4 +1,9 @@
 """Plots and prose numbers of fig4_history: ground stress, dip, arching.
+
+The figure is drawn for the page's width (11 in, fonts of at least 9 pt, one legend for
+both histories below the panels, pile names beside the piles rather than over them);
+:func:`summary` gives the numbers of the page's sentences, :func:`outside_band` the dips
+lying outside their own bootstrap band (the page says why).
 """
 import matplotlib.pyplot as plt
 import numpy as np
@@ -12,19 +17,19 @@ def plot_piles(ax, piles):
     from matplotlib.collections import PatchCollection
     from matplotlib.patches import Circle
     d = piles[0].attrs["mean_diameter"]
-    off = 0.0
+    off, ticks = 0.0, []
     for ds in piles:
         h = ds.attrs["history"]
         circles = [Circle((x / d, (y + off) / d), r / d) for x, y, r in zip(ds.x.values, ds.y.values,
                                                                            ds.radius.values)]
         ax.add_collection(PatchCollection(circles, facecolor=COLORS[h], edgecolor="none", alpha=0.8))
-        ax.text(0.02, (off + 0.5 * d) / d, f"{LABELS[h]}, pile {ds.attrs['member']}", fontsize=8,
-                transform=ax.get_yaxis_transform())
+        ticks.append(((off + 0.5 * ds.y.max().item()) / d, f"{LABELS[h]}\n(pile {ds.attrs['member']})"))
         off += (ds.y.max().item() + 3 * d)
     ax.autoscale_view()
     ax.set_aspect("equal")
     ax.set_xlabel("x / d")
-    ax.set_yticks([])
+    ax.set_yticks([t for t, _ in ticks], [lab for _, lab in ticks], fontsize=9)   # beside the piles
+    ax.tick_params(axis="y", length=0)
 
 
 def plot_stress(ax, an, kernel=None):
@@ -33,13 +38,11 @@ def plot_stress(ax, an, kernel=None):
     for h in an.history.values:
         s = an.sel(history=h, kernel=k)
         ax.fill_between(an.xi, s.profile_lo, s.profile_hi, color=COLORS[h], alpha=0.25, lw=0)
-        ax.plot(an.xi, s.profile_mean, color=COLORS[h],
-                label=f"{LABELS[h]} ({an.sizes['pile']} piles)")
+        ax.plot(an.xi, s.profile_mean, color=COLORS[h])
     ax.axhline(1.0, color="0.6", lw=0.6, ls=":")
-    ax.set_xlabel("x / L (L: base half-width of the point-source pile)")
+    ax.set_xlabel("x / L")
     ax.set_ylabel("ground stress / (W / 2L)")
-    ax.set_title(f"kernel {k:g} d, {int(100 * an.attrs['level'])} % bootstrap band over piles", fontsize=9)
-    ax.legend(fontsize=8)
+    ax.set_title(f"(b) mean ground stress, kernel {k:g} d", fontsize=10, loc="left")
 
 
 def plot_dips(ax, an):
@@ -57,15 +60,12 @@ def plot_dips(ax, an):
             # a bar from lo to hi, not an error bar: the dip of the mean profile (a min/max of
             # a mean) can lie outside its percentile bootstrap band (biased upwards by noise)
             ax.vlines(x, lo, hi, color=COLORS[h], lw=1.2)
-            ax.plot(x, m, "o", color=COLORS[h], label=LABELS[h] if j == 0 else None)
-    for j, k in enumerate(ks):
-        ax.text(j, 0.97, f"p = {float(an.dip_diff_p.sel(kernel=k)):.3g}", ha="center", va="top", fontsize=7,
-                transform=ax.get_xaxis_transform())
+            ax.plot(x, m, "o", color=COLORS[h])
     ax.axhline(0, color="0.6", lw=0.6)
-    ax.set_xticks(range(len(ks)), [f"{k:g} d" for k in ks])
-    ax.set_xlabel("kernel width")
-    ax.set_ylabel("dip depth (M - m) / M  (< 0: hump)")
-    ax.legend(fontsize=8)
+    ax.set_xticks(range(len(ks)), [f"{k:g} d\np = {float(an.dip_diff_p.sel(kernel=k)):.2g}" for k in ks])
+    ax.set_xlabel("kernel width (p: point vs rain)")
+    ax.set_ylabel("dip depth M − m (units of W / 2L)")
+    ax.set_title("(c) dip depth (> 0 a dip, < 0 a hump)", fontsize=10, loc="left")
 
 
 def plot_arching(ax, an):
@@ -81,29 +81,57 @@ def plot_arching(ax, an):
                 for f, sign in (("left", -1), ("right", 1)):
                     s = an.sel(history=h, pile=m, flank=f)
                     x = sign * q + (i - 0.5) * 0.35 * step + 0.3 * step * (j + 0.5) / max(len(done), 1) * sign
-                    ax.vlines(x, s.exact_deviation_min, s.exact_deviation_max, color=COLORS[h], lw=0.6, alpha=0.6,
-                              label=f"{LABELS[h]}: exact range, {len(done)} piles" if (j == 0 and f == "left")
-                              else None)
+                    ax.vlines(x, s.exact_deviation_min, s.exact_deviation_max, color=COLORS[h], lw=0.6, alpha=0.6)
         for f, sign in (("left", -1), ("right", 1)):
             s = an.sel(history=h, flank=f)
             x = sign * q
             ax.fill_between(x, s.deviation_q25, s.deviation_q75, color=COLORS[h], alpha=0.15, lw=0)
             ax.vlines(x, s.deviation_median_lo, s.deviation_median_hi, color=COLORS[h], lw=1.0)
-            ax.plot(x, s.deviation_median, "o-", ms=3, color=COLORS[h], label=LABELS[h] if f == "left" else None)
+            ax.plot(x, s.deviation_median, "o-", ms=3, color=COLORS[h])
     ax.axhline(0, color="0.6", lw=0.6)
     ax.set_xlabel("cut position x / L")
-    ax.set_ylabel("resultant angle - flank slope (deg)")
-    ax.legend(fontsize=8)
+    ax.set_ylabel("resultant angle − flank slope (°)")
+    ax.set_title("(d) arching across vertical cuts", fontsize=10, loc="left")
 
 
 def figure(an, piles):
-    fig = plt.figure(figsize=(11, 8), constrained_layout=True)
-    gs = fig.add_gridspec(2, 3)
-    plot_piles(fig.add_subplot(gs[0, :]), piles)
-    plot_stress(fig.add_subplot(gs[1, 0]), an)
-    plot_dips(fig.add_subplot(gs[1, 1]), an)
-    plot_arching(fig.add_subplot(gs[1, 2]), an)
+    """(a) one pile per history, (b) mean ground stress, (c) dip depths, (d) arching; one
+    legend for the histories and the kinds of marks, below the panels."""
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    with plt.rc_context({"font.size": 9.5}):
+        fig = plt.figure(figsize=(11, 8.4), layout="constrained")
+        gs = fig.add_gridspec(2, 3, height_ratios=[1, 1.25])
+        ax = fig.add_subplot(gs[0, :])
+        plot_piles(ax, piles)
+        ax.set_title("(a) the final piles, one per history (the same grains)", fontsize=10, loc="left")
+        plot_stress(fig.add_subplot(gs[1, 0]), an)
+        plot_dips(fig.add_subplot(gs[1, 1]), an)
+        plot_arching(fig.add_subplot(gs[1, 2]), an)
+        n, level = an.sizes["pile"], int(100 * an.attrs["level"])
+        handles = [Line2D([], [], color=COLORS[h], marker="o", ms=4, label=f"{LABELS[h]} ({n} piles)")
+                   for h in an.history.values]
+        handles += [Patch(color="0.6", alpha=0.35, label=f"(b) {level} % bootstrap band over piles"),
+                    Line2D([], [], color="0.3", ls="none", marker=".", label="(c) one pile"),
+                    Line2D([], [], color="0.3", marker="o", lw=1.2, label="(c) mean profile, bar: its band"),
+                    Line2D([], [], color="0.3", lw=0.6, label="(d) exact range over A ∩ C, one pile")]
+        fig.legend(handles=handles, loc="outside lower center", ncol=3, fontsize=9, frameon=False)
     return fig
+
+
+def outside_band(an):
+    """(history, kernel, dip, lo, hi) of every mean-profile dip outside its own basic
+    bootstrap band: the band subtracts the upward bias of the resampled dips (a minimum
+    against maxima of noisy profiles), which can exceed the band's half-width."""
+    out = []
+    for h in an.history.values:
+        for k in an.kernel.values:
+            s = an.sel(history=h, kernel=k)
+            m, lo, hi = float(s.dip_mean), float(s.dip_lo), float(s.dip_hi)
+            if not lo <= m <= hi:
+                out.append((str(h), float(k), m, lo, hi))
+    return out
 
 
 def summary(an):
@@ -147,3 +175,15 @@ def summary(an):
     out["diff_lo"], out["diff_hi"] = float(an.dip_diff_lo.sel(kernel=k0)), float(an.dip_diff_hi.sel(kernel=k0))
     out["p"] = {float(k): float(an.dip_diff_p.sel(kernel=k)) for k in an.kernel.values}
     return out
+
+
+def outside_text(an):
+    """One sentence on the dips of :func:`outside_band` (empty when every dip lies in its band)."""
+    out = outside_band(an)
+    if not out:
+        return ""
+    cases = "; ".join(f"{LABELS[h]}, kernel {k:g} d: {m:.3f} against [{lo:.3f}, {hi:.3f}]" for h, k, m, lo, hi in out)
+    return (f"A dip of a mean profile lies outside its own band ({cases}): the basic bootstrap band is "
+            "2 × dip − the percentiles of the resampled dips, which removes their upward bias (a minimum against "
+            "maxima of noisy profiles; largest for the narrowest kernel); where the bias exceeds the band's "
+            "half-width the band, the bias-corrected statement, lies below the raw dip.")

@@ -82,7 +82,7 @@ def size_dataset(analyses, seed=16):
             "grains": one(Z, np.array(grains)[order], "1", "grains per pile (mean over piles, rounded)"),
             "piles": one(Z, np.array([an.sizes["pile"] for an in ans]), "1", "piles per history"),
             "n_grains_mean": one((Z, Hd), mean_over("n_grains"), "1", "grains in the final pile, mean over piles"),
-            "dip_mean": one((Z, Hd, Kd), dip_mean, "1", "dip depth of the mean profile (M - m) / M"),
+            "dip_mean": one((Z, Hd, Kd), dip_mean, "1", "dip depth M - m of the mean profile over piles, units of the mean ground stress W/2L, > 0 a dip"),
             "dip_lo": one((Z, Hd, Kd), stack("dip_lo"), "1", "bootstrap band over piles of dip_mean, lower"),
             "dip_hi": one((Z, Hd, Kd), stack("dip_hi"), "1", "bootstrap band over piles of dip_mean, upper"),
             "dip_size_diff": one((Z, Hd, Kd), dip_mean - dip_mean[:1], "1",

@@ -19,7 +19,7 @@ from ncd.scenes import cuts as cm
 from ncd.scenes import pressure as pm
 from ncd.scenes.pile import cut_specs, pile_problem
 from ncd.scenes.sources import mean_diameter
-from ncd.solver.convergence import OUTCOMES, REST
+from ncd.solver.convergence import REST
 
 __all__ = ["ExactSet", "exact_dataset", "pile_problem", "resultant_angle"]
 
@@ -101,6 +101,9 @@ def exact_dataset(cfg, construction, cuts, log=None):
     # the dip: depth per analysis choice, history values, exact ranges
     labels, D = pm.sensitivity_rows(c, nm, d, ex["dip_offset_d"] * d, ex["kernel_widths_d"],
                                     ex["bin_widths_d"], ex["bin_shifts"])
+    # in units of the mean ground stress W / 2L (2L: toe to toe), as the history piles' dip
+    mean_stress = weight / (float(cuts.attrs["right_toe"]) - float(cuts.attrs["left_toe"]))
+    D = (D / mean_stress).tocsr()
     depth_hist = D @ history
     depth_band = es.intervals(D)
     main = labels.index(f"kernel {ex['kernel_d']:g} d")
@@ -144,9 +147,9 @@ def exact_dataset(cfg, construction, cuts, log=None):
             "kernel_max": ("x_kernel", band_kernel[:, 1], {"units": "N m-1", "long_name": "exact maximum of the kernel ground pressure over A ∩ C"}),
             "kernel_history": ("x_kernel", K @ history, {"units": "N m-1", "long_name": "kernel ground pressure of the history forces"}),
             "choice": ("choice", np.array(labels), {"units": "1", "long_name": "ground-pressure estimate (kernel width, or bin width and shift)"}),
-            "depth_history": ("choice", depth_hist, {"units": "N m-1", "long_name": "dip depth p(0) - (p(-a) + p(a))/2 of the history forces"}),
-            "depth_min": ("choice", depth_band[:, 0], {"units": "N m-1", "long_name": "exact minimum of the dip depth over A ∩ C"}),
-            "depth_max": ("choice", depth_band[:, 1], {"units": "N m-1", "long_name": "exact maximum of the dip depth over A ∩ C"}),
+            "dip_history": ("choice", depth_hist, {"units": "1", "long_name": "dip depth (p(-a) + p(a))/2 - p(0) of the history forces, in units of the mean ground stress W/2L (> 0 a dip, < 0 a hump)"}),
+            "dip_min": ("choice", depth_band[:, 0], {"units": "1", "long_name": "exact minimum over A ∩ C of the dip depth (units of W/2L, > 0 a dip)"}),
+            "dip_max": ("choice", depth_band[:, 1], {"units": "1", "long_name": "exact maximum over A ∩ C of the dip depth (units of W/2L, > 0 a dip)"}),
         },
         coords={"cut": cuts["cut"].values, "vertex": np.arange(width), "bin": cuts["bin"].values,
                 "x_kernel": xg},
@@ -154,7 +157,7 @@ def exact_dataset(cfg, construction, cuts, log=None):
                          vertex_equilibrium=vertex_check[0], vertex_coulomb=vertex_check[1],
                          vertex_refinement=vertex_shift,
                          dip_geometry=geometry, dip_called=called, dip_binning_spread=spread,
-                         dip_main_choice=labels[main], dip_offset=ex["dip_offset_d"] * d,
+                         dip_main_choice=labels[main], dip_offset=ex["dip_offset_d"] * d, dip_unit=mean_stress,
                          kernel_width=ex["kernel_d"] * d, n_lp_total=es.n_lp,
                          polygon_angle_gap=polygon_angle_gap),
     )
@@ -185,51 +188,6 @@ def cloud_in_polygon(exact, ens, k, mask):
     out = outside_distance(P, poly) if len(P) else np.zeros(0)
     area = float(exact.polygon_area.values[k])
     return P, out, (hull_area(P) / area if area > 0 and len(P) >= 3 else 0.0)
-
-
-def draw_cloud(ax, exact, ens, k, mask, color="C0", label=None):
-    """The exact polygon of cut ``k`` (shaded) and the converged rest runs (dots)."""
-    poly = polygon_of(exact, k)
-    ax.fill(*np.vstack([poly, poly[:1]]).T, color="0.85", lw=0.8, ec="0.4", label="exact projection of A ∩ C")
-    P, _, _ = cloud_in_polygon(exact, ens, k, mask)
-    ax.plot(P[:, 0], P[:, 1], ".", ms=2, color=color, label=label)
-    ax.set(xlabel="$F_x$ (N)", ylabel="$F_y$ (N)")
-    ax.set_aspect("equal", adjustable="datalim")
-
-
-def exact_text(exact, ens, cuts):
-    """Markdown from exact.nc and the ensemble: outcomes, polygons and coverage of the
-    default and shifted cuts, arching over all cuts, the ground-pressure dip verdict."""
-    a, W = exact.attrs, float(exact.attrs["weight"])
-    oc = ens["outcome"].values
-    counts = {OUTCOMES[k]: int((oc == k).sum()) for k in sorted(OUTCOMES)}
-    mask = oc == 1
-    lines = [f"Of the {len(oc)} zero-guess runs, {counts['rest']} converged at rest, {counts['motion']} converged "
-             f"on a motion solution (grains moving faster than the rest bound) and {counts['unconverged']} did "
-             f"not converge; only the {counts['rest']} rest states are drawn."]
-    for k, name in ((0, "default"), (1, "moved by -1 d"), (2, "moved by +1 d")):
-        P, out, cov = cloud_in_polygon(exact, ens, k, mask)
-        lines.append(f"Cut {name}: exact polygon of {int(exact.n_vertices[k])} vertices ({int(exact.n_lp[k])} LPs), "
-                     f"diameter {diameter(polygon_of(exact, k)):.4f} N; the rest runs cover "
-                     f"{100 * cov:.2g} % of its area and lie inside it to "
-                     f"{(out.max() if len(out) else 0.0) / W:.1e} of the weight.")
-    arch = exact.all_arch.values.astype(bool)
-    lines.append(f"Every admissible force state arches (pushes the bank downward) across {arch.sum()} of the "
-                 f"{len(arch)} cuts; the exact angle of the resultant below the horizontal spans "
-                 f"{np.nanmin(exact.angle_max.values - exact.angle_min.values):.1f}° to "
-                 f"{np.nanmax(exact.angle_max.values - exact.angle_min.values):.1f}° (median "
-                 f"{np.nanmedian(exact.angle_max.values - exact.angle_min.values):.1f}°) across a cut (each end a "
-                 f"linear-fractional program: {int(np.median(exact.angle_n_lp.values))} LPs per cut on median, "
-                 f"certified to {np.nanmax(exact.angle_bound.values):.0e}°; on the three polygons the ranges agree "
-                 f"with the polygons' own to {a['polygon_angle_gap']:.0e}°).")
-    m = list(exact.choice.values).index(a["dip_main_choice"])
-    lines.append(f"Ground pressure ({a['dip_main_choice']}): dip depth p(0) - (p(-a)+p(a))/2 with "
-                 f"a = {a['dip_offset'] * 1e3:.1f} mm is {float(exact.depth_history[m]):.1f} N/m for the history "
-                 f"forces; over the analysis choices it spans {a['dip_binning_spread']:.1f} N/m; over A ∩ C it "
-                 f"ranges exactly from {float(exact.depth_min[m]):.1f} to {float(exact.depth_max[m]):.1f} N/m: a dip "
-                 f"is **{a['dip_geometry']}** by the geometry, and "
-                 f"{'a dip is called' if a['dip_called'] else 'no dip is called'}.")
-    return "\n\n".join(lines)
 
 
 def diameter(v):

@@ -5,13 +5,19 @@ files; run by hand from anywhere in the checkout, :func:`paths` finds the reposi
 and names what a finished ``snakemake -j2 <figure>`` left under ``results/``, so a
 notebook writes only there.  :func:`check_pair` stops a run whose jupytext ``.py`` was
 edited without ``jupytext --sync`` (the ``.ipynb`` that Snakemake runs would be stale).
+:func:`save` records in the PNG the text layout of the figure (:func:`text_layout`: pairs
+of overlapping texts, the smallest font), which the page check reads at the size the
+page shows the figure (``tests/test_html.py``).
 """
+import json
 from pathlib import Path
 from types import SimpleNamespace
 
 import yaml
 
 MARKERS = ("Snakefile", "config.yaml")
+LAYOUT_KEY = "ncd-text-layout"   # the PNG text chunk holding text_layout's record
+MIN_FONT_PT = 9.0                # the smallest font a reader should meet at the page's size
 
 
 class NotebookError(RuntimeError):
@@ -68,11 +74,57 @@ def paths(figure, inputs, smk=None, data_dir=None):
         params=SimpleNamespace(config=section), config={figure: section})
 
 
+def drawn_texts(fig):
+    """The texts a draw of ``fig`` shows: visible, non-empty, and for tick labels only the
+    ticks inside their axis's view (matplotlib keeps labels of ticks it does not draw)."""
+    from matplotlib.text import Text
+
+    fig.canvas.draw()
+    ticks, shown = set(), []
+    for ax in fig.axes:
+        for axis in (ax.xaxis, ax.yaxis):
+            lo, hi = sorted(axis.get_view_interval())
+            pad = 1e-9 * max(abs(lo), abs(hi), 1.0)
+            for tick in axis.get_major_ticks() + axis.get_minor_ticks():
+                labels = (tick.label1, tick.label2)
+                ticks.update(id(t) for t in labels)
+                loc = tick.get_loc()
+                if loc is not None and lo - pad <= loc <= hi + pad and tick.get_visible():
+                    shown += [t for t in labels if t.get_visible() and t.get_text().strip()]
+    for t in fig.findobj(Text):
+        if id(t) not in ticks and t.get_visible() and t.get_text().strip() and t.get_alpha() != 0:
+            if all(a.get_visible() for a in (t.axes, t.get_figure(root=False)) if a is not None):
+                shown.append(t)
+    return shown
+
+
+def text_layout(fig, tol_px=1.0):
+    """What a reader meets in ``fig``'s texts: ``overlaps`` (pairs of texts whose boxes
+    intersect by more than ``tol_px`` pixels each way at the figure's dpi), ``min_font_pt``,
+    ``dpi`` and the figure's ``width_in``.  Text over data is not detected."""
+    texts = drawn_texts(fig)
+    renderer = fig.canvas.get_renderer()
+    boxes = [t.get_window_extent(renderer) for t in texts]
+    over = []
+    for i in range(len(texts)):
+        for j in range(i + 1, len(texts)):
+            a, b = boxes[i], boxes[j]
+            w = min(a.x1, b.x1) - max(a.x0, b.x0)
+            h = min(a.y1, b.y1) - max(a.y0, b.y0)
+            if w > tol_px and h > tol_px:
+                over.append([texts[i].get_text()[:40], texts[j].get_text()[:40]])
+    return {"overlaps": over, "min_font_pt": min((t.get_fontsize() for t in texts), default=None),
+            "dpi": float(fig.dpi), "width_in": float(fig.get_figwidth())}
+
+
 def save(fig, output, dpi=130, show=False, **kwargs):
     """Save ``fig`` to ``output.png`` and ``output.pdf`` (a PDF without creation date, so that
-    reruns give the same bytes); ``show`` also displays the PNG in the notebook."""
+    reruns give the same bytes); ``show`` also displays the PNG in the notebook.  The PNG
+    carries :func:`text_layout` at the saved dpi (text chunk :data:`LAYOUT_KEY`)."""
     Path(output.png).parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(output.png, dpi=dpi, **kwargs)
+    fig.set_dpi(dpi)
+    layout = json.dumps(text_layout(fig), ensure_ascii=True)
+    fig.savefig(output.png, dpi=dpi, metadata={LAYOUT_KEY: layout}, **kwargs)
     fig.savefig(output.pdf, metadata={"CreationDate": None}, **kwargs)
     if show:
         from IPython.display import Image, display

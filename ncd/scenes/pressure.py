@@ -4,8 +4,10 @@ Bins of fixed width hold a handful of contacts each, so a "dip" under the apex c
 from where the bin edges fall.  Every estimate here (Gaussian kernel average
 :func:`kernel_matrix`, shifted bins :func:`bin_matrix`, dip depth :func:`dip_row`) is
 instead a linear map of the contact forces, so that the same rows serve NLGS runs and
-the exact LP ranges of :mod:`ncd.figures.pile_exact`.  :func:`dip_verdict` calls a dip
-only when it exceeds the binning sensitivity and its exact range over A ∩ C is below zero.
+the exact LP ranges of :mod:`ncd.figures.pile_exact`.  The dip depth is the flank value
+minus the central value (> 0 a dip, < 0 a hump), the sign and name of the history
+piles' dip (:mod:`ncd.figures.history_analysis`).  :func:`dip_verdict` calls a dip only
+when it exceeds the binning sensitivity and its exact range over A ∩ C is above zero.
 """
 import numpy as np
 import scipy.sparse as sp
@@ -59,11 +61,11 @@ def centred_edges(width, shift, half_span):
 
 
 def dip_row(P, x, offset):
-    """Row of the dip depth ``p(0) - (p(-a) + p(a)) / 2`` from an estimate ``P`` at abscissae
-    ``x`` (the estimate's values are interpolated linearly; bins: their centres)."""
+    """Row of the dip depth ``(p(-a) + p(a)) / 2 - p(0)`` (> 0 a dip) from an estimate ``P``
+    at abscissae ``x`` (the estimate's values are interpolated linearly; bins: their centres)."""
     x = np.asarray(x, float)
     out = sp.csr_matrix((1, P.shape[1]))
-    for x0, w in ((0.0, 1.0), (-offset, -0.5), (offset, -0.5)):
+    for x0, w in ((0.0, -1.0), (-offset, 0.5), (offset, 0.5)):
         j = int(np.clip(np.searchsorted(x, x0) - 1, 0, len(x) - 2))
         t = (x0 - x[j]) / (x[j + 1] - x[j])
         out = out + w * ((1 - t) * P[j] + t * P[j + 1])
@@ -89,9 +91,10 @@ def sensitivity_rows(contacts, n_mobile, d, offset, kernel_widths_d, bin_widths_
 
 def dip_verdict(history_depth, binning_spread, exact_lo, exact_hi):
     """("forced" | "allowed" | "excluded", called): the geometry's verdict from the
-    exact range of the depth, and whether a dip is called for the history forces."""
-    geometry = "forced" if exact_hi < 0 else ("excluded" if exact_lo >= 0 else "allowed")
-    called = bool(history_depth < 0 and -history_depth > binning_spread and geometry == "forced")
+    exact range of the dip depth (> 0 a dip), and whether a dip is called for the history
+    forces (a depth above zero, above its spread over the analysis choices, and forced)."""
+    geometry = "forced" if exact_lo > 0 else ("excluded" if exact_hi <= 0 else "allowed")
+    called = bool(history_depth > 0 and history_depth > binning_spread and geometry == "forced")
     return geometry, called
 
 

@@ -7,7 +7,8 @@
 #   explore    zero-guess NLGS runs (random orders) of one shard of
 #              the ensemble or of the tolerance study               -> shards/<name>_<k>-of-<n>.nc
 #   merge      the shards, in member order                          -> ensemble.nc, tolerance.nc
-#   notebook   notebooks/fig4_pile.ipynb                            -> results/figures/fig4_pile.png|pdf
+#   notebook   notebooks/fig4_pile.ipynb (figure and sentences: ncd/figures/pile_plots.py)
+#                                                                   -> results/figures/fig4_pile.png|pdf
 FIG4 = "fig4_pile"
 CFG4 = section(FIG4)
 F4 = f"results/{FIG4}"
@@ -18,11 +19,14 @@ CFG4_CUTS = {**CFG4_SIM, **{k: CFG4[k] for k in ("surface", "cut", "pressure")}}
 CFG4_EXACT = {**CFG4_CUTS, "exact": CFG4["exact"]}
 CFG4_EXP = {**CFG4_CUTS, **{k: CFG4[k] for k in ("ensemble", "tolerance_study")}}
 F4_SHARDS = {"ensemble": CFG4["ensemble"]["shards"], "tolerance": CFG4["tolerance_study"]["shards"]}
+# the page's figure and sentences (ncd/figures/pile_plots.py) are read by the notebook only
+F4_PLOTS = str(REL / "ncd" / "figures" / "pile_plots.py")
+F4_SOURCES = [f for f in ncd_sources(FIG4) if f != F4_PLOTS]
 
 
 rule fig4_pile_simulate:
     input:
-        ncd_sources(FIG4),
+        F4_SOURCES,
     output:
         f"{F4}/construction.nc",
     params:
@@ -39,7 +43,7 @@ rule fig4_pile_simulate:
 
 rule fig4_pile_cuts:
     input:
-        ncd_sources(FIG4),
+        F4_SOURCES,
         construction=f"{F4}/construction.nc",
     output:
         f"{F4}/cuts.nc",
@@ -57,7 +61,7 @@ rule fig4_pile_cuts:
 
 rule fig4_pile_exact:
     input:
-        ncd_sources(FIG4),
+        F4_SOURCES,
         construction=f"{F4}/construction.nc",
         cuts=f"{F4}/cuts.nc",
     output:
@@ -76,7 +80,7 @@ rule fig4_pile_exact:
 
 rule fig4_pile_explore:
     input:
-        ncd_sources(FIG4),
+        F4_SOURCES,
         construction=f"{F4}/construction.nc",
         cuts=f"{F4}/cuts.nc",
     output:
@@ -124,6 +128,7 @@ rule fig4_pile_notebook:
         ensemble=f"{F4}/ensemble.nc",
         tolerance=f"{F4}/tolerance.nc",
         exact=f"{F4}/exact.nc",
+        plots=F4_PLOTS,
         notebook=notebook_file(FIG4),
         notebook_py=notebook_file(FIG4, "py"),
         pages=page_sources("notebook"),

@@ -1,6 +1,7 @@
 # Rules shared by every figure (included after common.smk, which holds only helpers):
 #   html_mathjax  MathJax copied beside the pages          -> results/html/mathjax/
-#   render_html   executed notebook -> clean offline page  -> results/html/<figure>.html
+#   render_html   executed notebook -> clean offline page, with links to the index and
+#                 the neighbouring pages               -> results/html/<figure>.html
 #   thumbnail(s)  README thumbnails                         -> docs/thumbnails/<figure>.png
 
 
@@ -21,7 +22,8 @@ rule html_mathjax:
 rule render_html:
     """Render an executed notebook (written by its figure's notebook rule) to a clean HTML
     page: no Snakemake preamble, code hidden behind a button, long tables folded, maths
-    typeset offline (ncd.pages.render)."""
+    typeset offline, nothing loaded from the network, a header linking to the index, the
+    neighbouring pages (in the order of FIGURES) and the paper (ncd.pages.render)."""
     input:
         png="results/figures/{figure}.png",
         mathjax="results/html/mathjax",
@@ -30,6 +32,7 @@ rule render_html:
         html="results/html/{figure}.html",
     params:
         executed="results/notebooks/{figure}.ipynb",
+        pages=FIGURES,
     log:
         "results/logs/{figure}/render_html.log",
     benchmark:

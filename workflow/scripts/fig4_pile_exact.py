@@ -12,8 +12,8 @@ write_dataset(ds, snakemake.output[0])  # noqa: F821
 a = ds.attrs
 m = list(ds.choice.values).index(a["dip_main_choice"])
 log.info("default cut: %d vertices, %d LPs, %.1f s; cuts where every admissible state arches: %d of %d; "
-         "dip (%s): history depth %.4g N/m, binning spread %.3g, exact range [%.4g, %.4g] -> %s, called: %s",
+         "dip (%s, units of W/2L, > 0 a dip): history %.4g, binning spread %.3g, exact range [%.4g, %.4g] -> %s, called: %s",
          int(ds.n_vertices[0]), int(ds.n_lp[0]), float(ds.polygon_wall_time[0]), int(ds.all_arch.sum()),
-         ds.sizes["cut"], a["dip_main_choice"], float(ds.depth_history[m]), a["dip_binning_spread"],
-         float(ds.depth_min[m]), float(ds.depth_max[m]), a["dip_geometry"],
+         ds.sizes["cut"], a["dip_main_choice"], float(ds.dip_history[m]), a["dip_binning_spread"],
+         float(ds.dip_min[m]), float(ds.dip_max[m]), a["dip_geometry"],
          a["dip_called"])
