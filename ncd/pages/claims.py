@@ -11,7 +11,8 @@ measures is listed as *not tested* with the reason in :data:`UNTESTED_REASONS`.
 Criteria follow the paper's wording: a "may" is judged over the cases it ranges over
 (cuts, steps, runs), a statement in R^2κ is tested in R^2κ, a claim about usable step
 sizes counts only accurate runs.  One name, unit and sign per quantity: the *dip depth*
-is the pressure deficit under the apex, > 0 a dip, in N/m unless said otherwise.
+is the flank pressure minus the pressure under the apex (> 0 a dip) in units of the mean
+ground stress W/2L, on both Figure 4 pages.
 """
 import math
 from functools import lru_cache
@@ -546,18 +547,17 @@ def fig4_pressure_height(results):
 
 def fig4_dip(results):
     """The verdict of the fig4_pile page (:func:`ncd.scenes.pressure.dip_verdict`): a dip is
-    called only when the history's depth exceeds the spread over analysis choices and the
-    exact range over A ∩ C forces it.  Reported with > 0 a dip."""
+    called only when the history's dip depth exceeds the spread over analysis choices and
+    the exact range over A ∩ C forces it."""
     ex = _open(results, F4[2])
     a = ex.attrs
     m = [str(c) for c in ex.choice.values].index(a["dip_main_choice"])
-    depth, lo, hi = (float(ex[v].values[m]) for v in ("depth_history", "depth_min", "depth_max"))
-    depth, lo, hi = -depth, -hi, -lo       # stored as pressure minus the flanks' level: < 0 a dip
+    depth, lo, hi = (float(ex[v].values[m]) for v in ("dip_history", "dip_min", "dip_max"))
     called = bool(a["dip_called"])
-    return _v(f"dip depth (pressure deficit under the apex, > 0 a dip) of the history forces ({a['dip_main_choice']}): "
-              f"{depth:.3g} N/m; spread over the analysis choices {float(a['dip_binning_spread']):.3g} N/m; exact "
-              f"range over A ∩ C [{lo:.3g}, {hi:.3g}] N/m: a dip {a['dip_geometry']} by the geometry",
-              REPRODUCED if called else DIFFERS,
+    return _v(f"dip depth (flank minus centre, > 0 a dip, units of the mean ground stress W/2L) of the history forces "
+              f"({a['dip_main_choice']}): {depth:+.3f}; spread over the analysis choices "
+              f"{float(a['dip_binning_spread']):.3f}; exact range over A ∩ C [{lo:+.3f}, {hi:+.3f}]: a dip "
+              f"{a['dip_geometry']} by the geometry", REPRODUCED if called else DIFFERS,
               "a \"may\": a dip in this pile beyond the analysis-choice spread, forced by the geometry",
               "s5-dip", F4[2])
 
@@ -616,8 +616,8 @@ def fig4_history_dip(results):
     s = an.isel(kernel=0)
     p, r = s.sel(history="point"), s.sel(history="rain")
     lo, hi = float(p.dip_lo), float(p.dip_hi)
-    return _v(f"dip depth of the mean profile (pressure deficit under the apex relative to the flanks, > 0 a dip, "
-              f"dimensionless) over {an.sizes['pile']} point-source piles {float(p.dip_mean):.3f} [{lo:.3f}, {hi:.3f}] "
+    return _v(f"dip depth of the mean profile (flank minus centre, > 0 a dip, units of the mean ground stress W/2L) "
+              f"over {an.sizes['pile']} point-source piles {float(p.dip_mean):.3f} [{lo:.3f}, {hi:.3f}] "
               f"(rain {float(r.dip_mean):.3f}; difference p = {float(s.dip_diff_p):.2g})",
               REPRODUCED if lo > 0 else DIFFERS, "a \"may\" over piles: the 95 % bootstrap band over point-source "
               "piles of the dip depth above 0", "s5-dip", rel)
