@@ -90,3 +90,17 @@ def test_hand_typed_number_is_noticed():
     text = ("# %% [markdown]\n# intro 60 %\n\n# %%\nx = 1\n\n# %% [markdown]\n"
             "# The clouds cover about 60 % and 95 %; $h = 0.3$ ms is `tol: 1.5`.\n")
     assert typed_numbers(jupytext.reads(text, fmt="py:percent")) == ["60 %", "95 %"]
+
+
+CODE_LINES_MAX = 120
+
+
+@pytest.mark.parametrize("py", NOTEBOOKS, ids=lambda p: p.stem)
+def test_notebook_narrates_and_the_package_computes(py):
+    """A page reads like a paper section: its cells call tested package functions, so a
+    notebook holds at most CODE_LINES_MAX lines of code (comments and blanks not counted)
+    and prints no raw DataFrame."""
+    cells = [c for c in jupytext.read(py).cells if c.cell_type == "code"]
+    lines = [s for c in cells for s in c.source.splitlines() if s.strip() and not s.strip().startswith("#")]
+    assert len(lines) <= CODE_LINES_MAX, f"{py.name}: {len(lines)} lines of code"
+    assert not any(s.strip().startswith(("print(df", "display(df")) for s in lines)
