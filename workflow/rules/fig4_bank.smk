@@ -8,25 +8,28 @@
 #   notebook   notebooks/fig4_bank.ipynb                         -> results/figures/fig4_bank.png|pdf
 # Uses the names of fig4_pile.smk and fig4_history.smk (included before this file, FIGURES order):
 # the configs that built the piles (CFG4_SIM, SIM_KEYS) and the pile files (piles_of(NH)).
-FIGB = "fig4_bank"
-CFGB = section(FIGB)
-FB = f"results/{FIGB}"
-CFGB_MEASURE = {k: v for k, v in CFGB.items() if k != "exact"}
+BANK_FIG = "fig4_bank"
+BANK_CFG = section(BANK_FIG)
+BANK_DIR = f"results/{BANK_FIG}"
+BANK_MEASURE_CFG = {k: v for k, v in BANK_CFG.items() if k != "exact"}
 BANK_EXACT = ["default"] + [f"{h}_{m:03d}" for h in ("point", "rain")
-                            for m in range(min(CFGB["exact"]["members"], CFGH["piles"]))]
+                            for m in range(min(BANK_CFG["exact"]["members"], CFGH["piles"]))]
 
+BANK_HISTORY_PILES = f"{FH}/piles/n{NH}"
+BANK_PILES = piles_of(NH)
 # the computing rules do not depend on the plots and the claims (editing them reruns the notebook only)
-BANK_SOURCES = [f for f in ncd_sources(FIGB) if not f.endswith(("bank_plots.py", "bank_claims.py"))]
+BANK_SOURCES = [f for f in ncd_sources(BANK_FIG) if not f.endswith(("bank_plots.py", "bank_claims.py"))]
 
 
 def bank_pile(name):
     """The file of pile ``name`` (default: fig4_pile's construction; else a fig4_history pile)."""
-    return f"results/fig4_pile/construction.nc" if name == "default" else f"{FH}/piles/n{NH}/{name}.nc"
+    return "results/fig4_pile/construction.nc" if name == "default" else f"{BANK_HISTORY_PILES}/{name}.nc"
 
 
-def bank_pile_config(name):
-    """The config section that built pile ``name`` (its equilibrium problem for the exact LPs)."""
-    return CFG4_SIM if name == "default" else {k: CFGH[k] for k in SIM_KEYS}
+# the config sections that built the piles (their equilibrium problems for the exact LPs), bound now:
+# a name of another rules file could be rebound by a later include before a params function runs
+BANK_PILE_CFG = {True: dict(CFG4_SIM), False: {k: CFGH[k] for k in SIM_KEYS}}
+BANK_EXACT_CFG = {k: v for k, v in BANK_CFG.items() if k not in ("analysis", "vertical_tol_deg", "failure_tol")}
 
 
 rule fig4_bank_measure:
@@ -34,15 +37,15 @@ rule fig4_bank_measure:
         BANK_SOURCES,
         construction="results/fig4_pile/construction.nc",
         cuts="results/fig4_pile/cuts.nc",
-        piles=piles_of(NH),
+        piles=BANK_PILES,
     output:
-        f"{FB}/measures.nc",
+        f"{BANK_DIR}/measures.nc",
     params:
-        config=CFGB_MEASURE,
+        config=BANK_MEASURE_CFG,
     log:
-        log(FIGB, "measure"),
+        log(BANK_FIG, "measure"),
     benchmark:
-        bench(FIGB, "measure")
+        bench(BANK_FIG, "measure")
     conda:
         CONDA_ENV
     script:
@@ -55,16 +58,16 @@ rule fig4_bank_exact:
         pile=lambda w: bank_pile(w.pile),
         cuts="results/fig4_pile/cuts.nc",
     output:
-        f"{FB}/exact/{{pile}}.nc",
+        f"{BANK_DIR}/exact/{{pile}}.nc",
     wildcard_constraints:
         pile=r"default|(point|rain)_\d+",
     params:
-        config=lambda w: {k: v for k, v in CFGB.items() if k not in ("analysis", "vertical_tol_deg", "failure_tol")},
-        pile_config=lambda w: bank_pile_config(w.pile),
+        config=BANK_EXACT_CFG,
+        pile_config=lambda w: BANK_PILE_CFG[w.pile == "default"],
     log:
-        log(FIGB, "exact_{pile}"),
+        log(BANK_FIG, "exact_{pile}"),
     benchmark:
-        bench(FIGB, "exact_{pile}")
+        bench(BANK_FIG, "exact_{pile}")
     conda:
         CONDA_ENV
     script:
@@ -73,23 +76,23 @@ rule fig4_bank_exact:
 
 rule fig4_bank_notebook:
     input:
-        measures=f"{FB}/measures.nc",
-        exact=[f"{FB}/exact/{p}.nc" for p in BANK_EXACT],
+        measures=f"{BANK_DIR}/measures.nc",
+        exact=[f"{BANK_DIR}/exact/{p}.nc" for p in BANK_EXACT],
         construction="results/fig4_pile/construction.nc",
         cuts="results/fig4_pile/cuts.nc",
-        notebook=notebook_file(FIGB),
-        notebook_py=notebook_file(FIGB, "py"),
+        notebook=notebook_file(BANK_FIG),
+        notebook_py=notebook_file(BANK_FIG, "py"),
         pages=page_sources("notebook"),
         plots=[str(REL / "ncd" / "figures" / f"{m}.py") for m in ("bank_plots", "bank_claims")],
     output:
-        png=figure_output(FIGB, "png"),
-        pdf=figure_output(FIGB, "pdf"),
+        png=figure_output(BANK_FIG, "png"),
+        pdf=figure_output(BANK_FIG, "pdf"),
     params:
-        config=CFGB,
+        config=BANK_CFG,
     log:
-        notebook=f"results/notebooks/{FIGB}.ipynb",
+        notebook=f"results/notebooks/{BANK_FIG}.ipynb",
     benchmark:
-        bench(FIGB, "notebook")
+        bench(BANK_FIG, "notebook")
     conda:
         CONDA_ENV
     notebook:
@@ -98,4 +101,4 @@ rule fig4_bank_notebook:
 
 rule fig4_bank:
     input:
-        figure_targets(FIGB),
+        figure_targets(BANK_FIG),

@@ -20,5 +20,5 @@ for h in out.history.values:
     s = out.sel(history=h)
     log.info("%s: angle to the vertical, median %.2f deg [%.2f, %.2f]; load / column weight %.3f; "
              "tau/sigma_n / tan(flank) %.3f; largest |asymmetry| %.2g", h, float(s.angle), float(s.angle_lo),
-             float(s.angle_hi), float(s.load), float(s.failure),
+             float(s.angle_hi), float(s["carried"]), float(s.failure),
              float(abs(out.asymmetry.where(out.pile_history == h)).max()))
