@@ -41,7 +41,7 @@
 #    centres below, over the grain–grain contacts whose line of centres crosses it (the
 #    convention of the vertical cuts). We keep its angle to the vertical and the weight of the
 #    grains above it in the vertical strip over it.
-# 2. *Exact ranges.* For the default pile and member 0 of each history, the exact range over
+# 2. *Exact ranges.* For the default pile and the first piles of each history, the exact range over
 #    $A \cap C$ of each cut's angle to the vertical (linear-fractional programs, as for the
 #    vertical cuts).
 # 3. *The granular stress tensor.* The Love–Weber average over a window covering the cut (a
@@ -106,7 +106,7 @@ display(Markdown(bc.cuts_text(ms)))
 # surface-parallel cuts, or only the history state?
 
 # %%
-display(Markdown(bc.exact_text(exact, tol)))
+display(Markdown(bc.exact_text(exact, tol, ms)))
 
 # %% [markdown]
 # ## <a id="stress"></a>The granular stress tensor

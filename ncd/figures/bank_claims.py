@@ -227,17 +227,27 @@ def cuts_text(ms):
     return " ".join(lines)
 
 
-def exact_text(exact, tol):
+def exact_load(ms, exact):
+    """Median over the exact piles' cuts of the exact range of the downward force over the column weight."""
+    widths = [(e.fy_max.values - e.fy_min.values) / ms.column_weight.sel(pile=name).values
+              for name, e in exact.items() if name in ms.pile.values]
+    return _nan(np.nanmedian, np.concatenate([w.ravel() for w in widths])) if widths else np.nan
+
+
+def exact_text(exact, tol, ms=None):
     """The exact ranges: width, how many cuts are forced within ``tol`` of the vertical, the history inside."""
     e = exact_summary(exact)
     if e is None or not e["cuts"]:
         return "No exact range was computed in this run."
+    load = exact_load(ms, exact) if ms is not None else np.nan
     forced = float(np.mean((e["lo"] >= -tol) & (e["hi"] <= tol)))
     contains = float(np.mean((e["lo"] <= 0) & (e["hi"] >= 0)))
     return (f"Over A ∩ C of {e['piles']} piles ({', '.join(exact)}), the exact range of the angle to the vertical of "
             f"the {e['cuts']} surface-parallel cuts spans {e['width_median']:.1f}° on median, at most "
             f"{e['width_max']:.1f}°. At {100 * forced:.0f} % of the cuts every admissible force state is within "
-            f"±{tol:g}° of the vertical; at {100 * contains:.0f} % the range contains the vertical. The history "
+            f"±{tol:g}° of the vertical; at {100 * contains:.0f} % the range contains the vertical"
+            + (f"; the downward component ranges over {100 * load:.0f} % of the column weight on median"
+               if np.isfinite(load) else "") + ". The history "
             f"resultant lies inside its range (at most {e['history_outside']:.1e}° outside, the tolerance of the "
             f"history equilibrium). "
             + ("The near-vertical force is thus a property of the history forces, not imposed on each cut by the "
