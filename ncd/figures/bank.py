@@ -203,14 +203,14 @@ PER_CUT = {   # variable: (units, long_name) of the arrays of measure_pile over 
 }
 
 
-def _band(values, idx, stat, lo, hi):
-    """``(estimate, lo, hi)`` of ``stat(values over piles and cuts)`` with a percentile
-    bootstrap over piles (``idx`` resampled pile indices; NaN band for one pile)."""
+def _band(values, idx, lo, hi):
+    """``(median, lo, hi)`` of the median of ``values`` over piles and cuts with a percentile
+    bootstrap over piles (``idx``: resampled pile indices; NaN band for one pile)."""
     v = values.reshape(values.shape[0], -1)
-    est = stat(v.ravel())
+    est = _median(v)
     if values.shape[0] < 2:
         return est, np.nan, np.nan
-    boot = np.array([stat(v[i].ravel()) for i in idx])
+    boot = _nan(np.nanmedian, v[idx].reshape(len(idx), -1), axis=1)
     return est, float(_nan(np.nanquantile, boot, lo)), float(_nan(np.nanquantile, boot, hi))
 
 
@@ -271,11 +271,11 @@ def bank_dataset(cfg, piles):
         for i, h in enumerate(histories):
             v = vals[hist == h]
             idx = rng.integers(0, len(v), size=(a["bootstrap"], len(v)))
-            pooled[i] = _band(v, idx, _median, lo, hi)
+            pooled[i] = _band(v, idx, lo, hi)
             for k in range(len(depths)):
-                by_depth[i, k] = _band(v[..., k], idx, _median, lo, hi)
+                by_depth[i, k] = _band(v[..., k], idx, lo, hi)
             for j in range(len(q)):
-                by_pos[i, j] = _band(v[:, :, j], idx, _median, lo, hi)
+                by_pos[i, j] = _band(v[:, :, j], idx, lo, hi)
         for suffix, arr, dims in (("", pooled, (H,)), ("_by_depth", by_depth, (H, D)),
                                   ("_by_position", by_pos, (H, Q))):
             for j, end in enumerate(("", "_lo", "_hi")):
