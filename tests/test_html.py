@@ -14,7 +14,7 @@ from ncd.pages.render import LONG_TABLE, copy_mathjax, render
 
 CHROMIUM = next((shutil.which(c) for c in ("chromium", "chromium-browser", "google-chrome") if shutil.which(c)), None)
 needs_chromium = pytest.mark.skipif(CHROMIUM is None, reason="chromium absent (apt-get install -y chromium)")
-FIGURES = ("fig1_wedged", "fig2_slope", "fig3_equilibrium", "fig4_pile", "stability", "error_vs_runtime")
+FIGURES = ("fig1_wedged", "fig2_slope", "fig3_equilibrium", "fig4_pile", "fig4_bank", "stability", "error_vs_runtime")
 
 
 def executed_notebook(path):

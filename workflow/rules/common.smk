@@ -23,7 +23,7 @@ REL = Path(os.path.relpath(ROOT))
 CONDA_ENV = "../envs/ncd.yaml"
 
 # Figures in the order of the paper; each has a rules file and a config section.
-FIGURES = [f for f in ("fig1_wedged", "fig2_slope", "fig3_equilibrium", "fig4_pile", "fig4_history",
+FIGURES = [f for f in ("fig1_wedged", "fig2_slope", "fig3_equilibrium", "fig4_pile", "fig4_history", "fig4_bank",
                        "fig5_governing", "stability", "error_vs_runtime")
            if (ROOT / "workflow" / "rules" / f"{f}.smk").exists()]
 
