@@ -12,6 +12,6 @@ FIGURE_MODULES = {
     "fig3_equilibrium": ("equilibrium", "faces"),
     "fig4_pile": ("pile", "pile_exact"),
     "fig4_history": ("history", "history_analysis", "history_exact", "history_plots", "history_size"),
-    "fig5_governing": ("governing", "governing_exact", "governing_flow", "governing_line", "governing_plot",
-                       "governing_summary"),
+    "fig5_governing": ("governing", "governing_claims", "governing_exact", "governing_flow", "governing_line",
+                       "governing_plot", "governing_summary", "governing_unger"),
 }
