@@ -23,7 +23,6 @@ from ncd.core.jit import njit
 from ncd.exact.polygon import support_polygon
 
 
-
 class PolytopeError(RuntimeError):
     """``A ∩ C`` is empty, or unbounded where a bounded set is needed, or an LP failed."""
 

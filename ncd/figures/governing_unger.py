@@ -31,7 +31,8 @@ def eta_u(samples):
     f = np.asarray(samples, float)
     if len(f) < 2:
         return np.nan
-    dF = np.sqrt(f[..., 0].var(axis=0, ddof=1) + f[..., 1].var(axis=0, ddof=1))
+    d = f - f[:1]                  # shifted by the first sample: identical samples give exactly 0
+    dF = np.sqrt(d[..., 0].var(axis=0, ddof=1) + d[..., 1].var(axis=0, ddof=1))
     mag = np.hypot(f[..., 0], f[..., 1]).mean()
     return float(dF.mean() / mag) if mag > 0 else np.nan
 

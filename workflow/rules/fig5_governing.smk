@@ -76,8 +76,12 @@ rule fig5_governing_notebook:
         notebook_py=notebook_file(FIG, "py"),
         pages=page_sources("notebook"),
     output:
-        png=figure_output(FIG, "png"),
-        pdf=figure_output(FIG, "pdf"),
+        # the report's caption is the finding, written by the notebook from the data
+        png=report(f"results/figures/{FIG}.png", caption=os.path.abspath(f"{F5}/caption.rst"), category=FIG,
+                   subcategory="PNG"),
+        pdf=report(f"results/figures/{FIG}.pdf", caption=os.path.abspath(f"{F5}/caption.rst"), category=FIG,
+                   subcategory="PDF"),
+        caption=f"{F5}/caption.rst",
     params:
         config=without_shards(CFG),
     log:
