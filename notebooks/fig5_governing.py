@@ -14,61 +14,53 @@
 # ---
 
 # %% [markdown]
-# # Figure 5 — what governs indeterminacy: friction, measured exactly over many packings
+# # Beyond the paper: governing parameters of indeterminacy
 #
 # **What the paper asked.** Section 3 of Moreau (2005) ends: "Further study is thus
 # needed to discover the governing parameters and to explain why the dispersion
 # produces a line". Every earlier figure rests on one packing, one flow, one step.
 #
 # **What Unger, Kertész & Wolf found** (PRL 94, 178001, 2005). Packings of 200 rigid
-# discs, radii uniform in $[R, 2R]$, compressed between two plates with periodic sides
-# (width $42R$), built by contact dynamics. They sampled the solution set by adding
-# noise to every contact force and relaxing by Gauss–Seidel, and measured
-# $\eta = \langle|\delta F|\rangle / \langle|F|\rangle$: $\eta \to 0$ as $\mu \to 0$,
-# $\eta \propto \mu$ at small $\mu$, a peak near $\mu \approx 0.1$, then a fall as the
-# coordination number drops.
+# discs, radii uniform in $[R, 2R]$, periodic sides of width $42R$, no gravity, compressed
+# between two plates under a constant force, built by contact dynamics at each $\mu$; a
+# middle slice of height $28R$ analysed with the forces across its boundaries held fixed.
+# From the force state at jamming they add to every contact force uniform noise in
+# $[-\langle F_n\rangle, \langle F_n\rangle]$, relax by Gauss–Seidel with contacts and
+# boundary forces fixed, and start the next round from the result: a random walk in the
+# solution set. Their measure is $\eta = \langle \delta F\rangle / \langle |F|\rangle$, with
+# $\delta F$ the standard deviation of a contact's force vector over the samples. They
+# report $\eta \to 0$ as $\mu \to 0$, $\eta \propto \mu$ at small $\mu$ with the
+# coordination $z$ still at its frictionless (isostatic) value 4, a maximum near
+# $\mu \approx 0.1$, a fall at larger $\mu$; a control series (one packing built without
+# friction, friction switched on for the sampling) with $\eta$ rising monotonically; and a
+# history force state closer to the centre of the solution set than random samples.
 #
-# **What we compute.** Packings built at each $\mu$ (log-spaced), in Unger et al.'s
-# geometry (bottom plate, periodic sides $42R$, compression by a body force toward the
-# plate, no lid — see `ncd/figures/governing.py` for why) and under gravity in a box.
-# On each: $\kappa$, the rank of the equilibrium equations, $\dim A$, $\dim(A\cap C)$
-# twice (rank count with the implicit equalities found by LP, and affine rank of LP
-# points), the exact range of every contact's normal and tangential force over
-# $A \cap C$ ($4\kappa$ LPs, HiGHS), the contacts fixed by statics, the exact ratio
-# $\eta_\mathrm{exact} = \sum_\alpha |\Delta r_\alpha| / \sum_\alpha |\bar r_\alpha|$
-# ($\Delta r$: widths of the two ranges, $\bar r$: centre of the range box), and
-# Unger et al.'s $\eta$ measured their way (uniform noise of amplitude
-# $a\langle|r|\rangle$, NLGS relaxation to a natural-map residual $\le 10^{-8}$ and
-# $u_f = 0$, a few rounds; $\eta_U = \langle|F_k - F_0|\rangle/\langle|F_0|\rangle$).
-# The two are different statistics of the same set: $\eta_\mathrm{exact}$ is its full
-# extent along each contact, $\eta_U$ the distance a short random walk travels in it.
-#
-# **Flows across parameters.** Figure 2's flow (the discs of
-# `fig2_slope.scene` on its rough periodic ground) is released at several friction
-# coefficients, time steps and slope angles, one factor at a time around Figure 2's
-# setting, several flows (seeds) per setting. Every setting of a seed is released from the
-# same deposit, built under gravity normal to the ground at the base's $\mu$: a setting
-# changes its one parameter at the release and nothing else. At fixed times after release each flow's next step is scanned as
-# Figure 2's scan does: zero-guess and warm-start NLGS runs with random review orders to a
-# natural-map residual $\le 10^{-8}$ with the grain accelerations settled (unconverged runs
-# are counted and left out: the first steps after release, grains nearly at rest under heavy
-# forces, often exhaust the sweep budget). Distinct end points (accelerations further apart
-# than a threshold) are then polished on their contact statuses to a residual $\le 10^{-10}$:
-# a step is *indeterminate* when two exact solutions or more remain distinct, *determinate*
-# when every end point polishes to one solution, *unknown* otherwise. At every indeterminate
-# step we record the contacts whose status differs, the grains whose acceleration differs and
-# the connected clusters they form, the number of independent directions the solutions span
-# over the whole field and over the cluster of the grain of largest spread, the rank of that
-# grain's acceleration cloud, and the dimension of the set of impulses (and of grain
-# velocities) keeping the statuses of the most frequent solution (the null space of its
-# sticking and sliding equations).
+# **What we compute.** Their geometry, scaled down for the default run (sizes below; their
+# size: `config/unger.yaml`). The top plate is a mobile rigid body of the scene
+# (`ncd/scenes/plates.py`): its mass enters the Delassus blocks of its contacts, NLGS moves
+# it as it moves a disc, and its vertical equilibrium is a row of $A$. Its contacts are
+# frictionless, so that it receives vertical forces only and translates along its normal
+# exactly; no solver kernel changes. A packing is at rest when the plate is slow and the
+# one-step test from rest gives $u_f = 0$; that test, finished on its contact statuses,
+# gives the exact reference forces. The middle slice is then one problem
+# $H r + F = 0$, $r \in C$: unknowns the forces between two slice discs, $F$ the
+# boundary forces of the reference. On it: the exact range of every force component over
+# $A \cap C$ and $\dim(A \cap C)$ by LP (`governing_exact`), with the **exact range ratio**
+# (range-box diagonals over box-centre forces: the full extent of the set, not $\eta$);
+# **their $\eta_U$ on their random walk** (each relaxed state checked to be a point of
+# $A\cap C$); **their $\eta_U$ on a uniform sample** of $A \cap C$ (hit-and-run in its affine
+# hull, two chains from dispersed starts whose agreement is the mixing check); the
+# coordination $z$ in the slice without rattlers; the distance of the history state to the
+# centre of the set.
 
 # %%
+from pathlib import Path
+
 import numpy as np
 import xarray as xr
 from IPython.display import Markdown, display
 
-from ncd.figures import governing as fg
+from ncd.figures import governing_claims as gc
 from ncd.figures import governing_plot as gp
 from ncd.figures import governing_summary as gs
 from ncd.pages.notebook import paths, save
@@ -77,85 +69,76 @@ _smk = paths("fig5_governing", ["packings", "flows"], globals().get("snakemake")
 inp, out, cfg = _smk.input, _smk.output, _smk.params.config
 ds = xr.load_dataset(inp.packings)
 flows = xr.load_dataset(inp.flows)
-kinds = sorted(set(ds.kind.values.tolist()))
+results = Path(inp.packings).parents[1]           # the results folder the claims read
 
 # %% [markdown]
 # ## The packings
 
 # %%
-p = cfg["packings"]
-n_mu = len(np.unique(ds.mu.values))
-lines = [f"{ds.sizes['packing']} packings of N = {ds.sizes['disc']} discs at {n_mu} values of μ "
-         f"from {ds.mu.values.min():.3g} to {ds.mu.values.max():.3g}; "
-         + ", ".join(f"{int((ds.kind.values == k).sum())} {fg.KINDS[k]}" for k in kinds) + ". ",
-         f"Built in {int(ds.build_steps.min())}–{int(ds.build_steps.max())} steps of h = {p['h']:g} s; "
-         f"largest interpenetration {float(ds.max_penetration.max()):.3f} R; every packing passed the "
-         f"equilibrium test (largest |u_f| = {float(ds.rest_velocity.max()):.1e} |g| h). ",
-         f"A ∩ C is unbounded (a self-stress inside C) in {int((ds.bounded == 0).sum())} packings "
-         f"({', '.join(f'{fg.KINDS[int(a)]} μ = {b:.3g}' for a, b in zip(ds.kind.values[ds.bounded == 0], ds.mu.values[ds.bounded == 0]))}): "
-         f"there some ranges are infinite, η_exact is undefined and left out of the bands. "
-         f"Exact measures: {int(ds.n_lp.sum())} LPs in all. dim(A∩C) by rank count and by LP agree on "
-         f"{int((ds.dim_AC_rank == ds.dim_AC_lp).sum())} of {ds.sizes['packing']} packings."]
-display(Markdown("".join(lines)))
+p, w, u = cfg["packings"], cfg["walk"], cfg["uniform"]
+plates = ds.kind.values == 0
+dim = ds.dim_AC_rank.values
+display(Markdown(
+    f"{ds.sizes['build']} packings of N = {p['n_discs']} discs, width {p['width_radii']} R, built by contact "
+    f"dynamics in {int(ds.build_steps.min())}–{int(ds.build_steps.max())} steps of h = {p['h']:g} s (largest "
+    f"interpenetration {float(ds.max_penetration.max()):.3f} R; every one passed the test from rest, "
+    f"largest |u_f| = {float(ds.rest_velocity.max()):.1e} load h): {p['per_mu']} at each of {p['n_mu']} values of "
+    f"μ from {p['mu_min']:g} to {p['mu_max']:g}, and {p['control']} frictionless (the control series, analysed "
+    f"at every μ). The middle slice of {p['slice_radii']} R holds {int(ds.n_slice.min())}–{int(ds.n_slice.max())} "
+    f"discs and {int(ds.n_contacts.min())}–{int(ds.n_contacts.max())} contacts; dim(A∩C) is "
+    f"{int(dim.min())}–{int(dim.max())} (rank count and LP agree on {int((ds.dim_AC_lp == ds.dim_AC_rank).sum())} "
+    f"of {ds.sizes['packing']} analyses); the slice's A ∩ C is bounded in {int(ds.bounded.sum())} and the whole "
+    f"cell's in {int(ds.bounded_cell.sum())} of them. Random walk: {w['samples']} rounds per analysis, "
+    f"{int(ds.walk_ok.sum() - ds.sizes['packing'])} of {w['samples'] * ds.sizes['packing']} relaxed states points "
+    f"of A ∩ C (a failed round leaves the walk in place). Uniform sample: 2 chains × {u['per_chain']} points; "
+    f"largest R-hat {np.nanmax(ds.rhat.values):.3f}, largest relative gap between the chains' η_U "
+    f"{np.nanmax(ds.eta_uniform_gap.values):.3f}."))
 
 # %% [markdown]
 # ## The figure
 
 # %%
 fig = gp.figure(ds, flows)
-save(fig, out, dpi=120)
+save(fig, out, dpi=110)
 
 # %% [markdown]
-# ## What we measured, and where it differs from Unger et al.
+# ## What we measured against Unger et al.
+#
+# Each paragraph states one of their findings, our measurement on their statistic and the
+# verdict (the same objects the index page prints).
 
 # %%
-text = []
-for k in kinds:
-    name = fg.KINDS[k]
-    te, tu = fg.eta_table(ds, "eta_exact", k), fg.eta_table(ds, "eta_unger", k)
-    pe, se = fg.peak_and_slope(te)
-    pu, su = fg.peak_and_slope(tu)
-    z = fg.eta_table(ds, "coordination", k)
-    dr = fg.eta_table(ds, "dim_ratio", k)
-    ff = fg.eta_table(ds, "fixed_fraction", k)
-    text.append(
-        f"**{name}** ({int(te[:, 3].min())}–{int(te[:, 3].max())} packings per μ with a bounded A ∩ C). "
-        f"Exact η: {te[0, 1]:.3g} at μ = {te[0, 0]:.3g}, largest mean "
-        f"{np.nanmax(te[:, 1]):.3g} at μ = {pe:.3g} (Unger et al.: peak near 0.1) and is {te[-1, 1]:.3g} at "
-        f"μ = {te[-1, 0]:.3g}; log-log slope over the two smallest μ: {se:.2f} (Unger et al.: 1). "
-        f"Unger et al.'s η measured their way: {tu[0, 1]:.3g} at the smallest μ, largest {np.nanmax(tu[:, 1]):.3g} at μ = {pu:.3g}, "
-        f"slope {su:.2f}; it is {np.nanmedian(ds.eta_unger.values[ds.kind.values == k] / ds.eta_exact.values[ds.kind.values == k]):.2f} "
-        f"times the exact η (median over packings). "
-        f"Coordination 2κ/N falls from {z[0, 1]:.2f} to {z[-1, 1]:.2f}; dim(A∩C)/2κ goes from "
-        f"{dr[0, 1]:.3f} to {dr[-1, 1]:.3f} (largest {np.nanmax(dr[:, 1]):.3f} at μ = {dr[np.nanargmax(dr[:, 1]), 0]:.3g}); "
-        f"the fraction of contacts fixed by statics from {ff[0, 1]:.3f} to {ff[-1, 1]:.3f}.")
-display(Markdown("\n\n".join(text)))
+def show(anchor, title, v, extra=""):
+    display(Markdown(f'<a id="{anchor}"></a>\n\n**{title}** {v.value}. *{v.verdict}* ({v.criterion}). {extra}'))
+
+
+m_u, lo_u, hi_u = gc.peak(ds, "eta_uniform")
+m_x, lo_x, hi_x = gc.peak(ds, "eta_exact")
+show("unger-peak", "Peak near μ = 0.1.", gc.claim_unger_peak(results),
+     f"On the uniform sample the largest η_U is at μ = {m_u:.3g} (band {lo_u:.3g}–{hi_u:.3g}); the exact range "
+     f"ratio is largest at μ = {m_x:.3g} (band {lo_x:.3g}–{hi_x:.3g}).")
+show("unger-vanishes", "η → 0 as μ → 0, η ∝ μ, z isostatic.", gc.claim_unger_vanishes(results),
+     f"Slope on the uniform sample {gc.small_mu_slope(ds, 'eta_uniform'):.2f}, of the exact range ratio "
+     f"{gc.small_mu_slope(ds, 'eta_exact'):.2f}.")
+show("unger-control", "Control series rises monotonically.", gc.claim_unger_control(results))
+n_c, closer, rank = gc.centrality_summary(ds)
+show("unger-centrality", "History state near the centre.", gc.claim_unger_centrality(results),
+     f"The random-walk samples stay at a median {np.nanmedian(ds.walk_distance / ds.uniform_distance):.2f} of the "
+     f"uniform samples' distance to the centre: the walk explores only part of the set.")
 
 # %%
-k0 = kinds[0]
-te, tu = fg.eta_table(ds, "eta_exact", k0), fg.eta_table(ds, "eta_unger", k0)
-(pe, se), (pu, su) = fg.peak_and_slope(te), fg.peak_and_slope(tu)
-grid = np.unique(ds.mu.values)
-nearest = grid[np.argmin(np.abs(np.log(grid / gp.UNGER_PEAK_MU)))]   # the grid point nearest mu = 0.1
+verdicts = [gc.claim_unger_peak(results), gc.claim_unger_vanishes(results), gc.claim_unger_control(results)]
+Path(getattr(out, "caption", Path(inp.packings).with_name("caption.rst"))).write_text(
+    "**Beyond the paper: governing parameters of indeterminacy** (Unger, Kertész & Wolf's packings, their "
+    f"statistic η_U). {verdicts[0].value} ({verdicts[0].verdict}); {verdicts[1].value} ({verdicts[1].verdict}); "
+    f"{verdicts[2].value} ({verdicts[2].verdict}). Details: ``results/html/fig5_governing.html``.\n")
 
-
-def where(m):
-    if m == grid.max():
-        return "the largest μ of the grid: no peak inside the range studied"
-    return "the grid point nearest Unger et al.'s 0.1" if m == nearest else f"not the grid point nearest 0.1 ({nearest:.3g})"
-
-
-display(Markdown(
-    f"**Where we agree and differ ({fg.KINDS[k0]}).** Largest mean exact η at μ = {pe:.3g}: {where(pe)}; "
-    f"largest mean η measured their way at μ = {pu:.3g}: {where(pu)}. Small-μ log-log "
-    f"slope: exact {se:.2f}, their way {su:.2f}, against their η ∝ μ (slope 1). "
-    f"The exact η is the full extent of the solution set along each contact (an upper envelope of any sampling); "
-    f"{cfg['unger']['rounds']} noise-and-relax rounds travel only part of it (median ratio printed above). "
-    f"Built-in differences: a body-force load (stress growing with depth) instead of a lid, the whole "
-    f"packing instead of a bulk slice with fixed boundary forces, and {int(te[:, 3].min())}–{int(te[:, 3].max())} "
-    f"packings per μ in this run"
-    + ("; with fewer than 3 packings at some μ the location of the largest mean is not resolved "
-       "(the seed bands of the figure)." if int(te[:, 3].min()) < 3 else ".")))
+# %% [markdown]
+# **Where a difference comes from.** The figure compares one thing at a time: the statistic
+# (exact range ratio against $\eta_U$, panels a–b), the sampler (their walk against a uniform
+# sample of the same set, panel f), the history (control against built-at-μ series,
+# panels a–b). The default run is smaller than theirs (slice and packings per μ: sizes above);
+# `config/unger.yaml` runs their size through the same code.
 
 # %% [markdown]
 # ## Flows: indeterminate steps against friction, time step and slope

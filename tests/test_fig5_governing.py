@@ -1,8 +1,8 @@
-"""Figure 5: exact measures of A ∩ C across friction, and Unger et al.'s eta.
+"""Figure 5: exact measures of A ∩ C across friction, Unger et al.'s eta_U on their walk
+and on a uniform sample, the mobile plate, the flows.
 
-Unit tests of :mod:`ncd.figures.governing_exact` on problems with a known answer and on
-a frictionless packing, then the claims of the figure on the data of the DAG run
-(fixture ``results``).
+Unit tests on problems with a known answer (a shared load, a uniform segment, a frictionless
+packing built between two plates), then the figure's data from the DAG run (fixture ``results``).
 """
 import numpy as np
 import pytest
@@ -12,10 +12,13 @@ import yaml
 
 import ncd
 from ncd.core.contacts import h_matrix
+from ncd.exact.polytope import ForcePolytope
 from ncd.figures import governing as fg
+from ncd.figures import governing_claims as gc
 from ncd.figures import governing_exact as ge
 from ncd.figures import governing_line as gl
-from ncd.scenes.packing import external_force, rest_problem
+from ncd.figures import governing_unger as gu
+from ncd.scenes import plates
 
 
 # ---------------------------------------------------------------- unit tests
@@ -40,74 +43,99 @@ def test_single_support_without_friction_is_determinate():
     assert m["implicit_sliding"][0]
 
 
-def small_box(check_every, tol, rest_tol):
-    """Packing parameters of a 14-disc box built by contact dynamics."""
-    return dict(n_discs=14, radius_min=0.01, width_radii=14, density=1.0, gravity=9.81, root_seed=3, h=2e-4,
-                max_steps=20000, check_every=check_every, speed_tol=1.0, velocity_tol=1e-6,
-                solver=dict(tol=tol, max_sweeps=1000, check_every=10),
-                rest_solver=dict(tol=rest_tol, max_sweeps=50000, check_every=10))
+def small_plates(**kw):
+    """Packing parameters of a 24-disc cell between two plates (the top one mobile), no gravity."""
+    p = dict(n_discs=24, radius_min=0.01, width_radii=12, slice_radii=6, density=1.0, load=9.81, plate_mass=0.2,
+             mu_min=0.01, mu_max=1.0, n_mu=2, per_mu=1, control=1, root_seed=3, h=2e-4, max_steps=20000,
+             check_every=50, speed_tol=1.0, velocity_tol=1e-6, solver=dict(tol=1e-3, max_sweeps=1000, check_every=10),
+             rest_solver=dict(tol=1e-8, max_sweeps=20000, check_every=10, finish="active_set", finish_tol=1e-12))
+    p.update(kw)
+    return p
 
 
-def test_frictionless_packing_is_determinate():
-    """A packing built by contact dynamics at mu = 0: every contact force fixed, eta = 0."""
-    p = small_box(check_every=100, tol=1e-4, rest_tol=1e-9)
-    scene, info = fg.build(p, "box", 0.0, member=0)
-    problem = rest_problem(scene, p["h"])
-    m = ge.exact_measures(h_matrix(scene, problem.contacts), external_force(scene), problem.contacts.mu)
-    assert m["n_contacts"] >= 14
-    assert (m["dim_AC_rank"], m["dim_AC_lp"]) == (0, 0)
-    assert m["n_fixed"] == m["n_contacts"]
-    assert m["eta_exact"] <= 1e-6
-    np.testing.assert_allclose(m["force_min"][:, 1], 0.0, atol=1e-9 * m["scale"])
+WALK = dict(samples=6, noise=1.0, point_tol=1e-8,
+            solver=dict(tol=1e-8, max_sweeps=20000, check_every=10, finish="active_set", finish_tol=1e-12))
 
 
-def test_unger_relax_records_a_packing_it_cannot_start_from():
-    """When the first relaxation does not reach rest (here: a 1-sweep budget), the packing
-    is recorded unsampled (later rounds NaN, flags False) instead of failing the shard."""
-    p = small_box(check_every=50, tol=1e-3, rest_tol=1e-8)
-    scene, _ = fg.build(p, "box", 0.5, member=1)
-    problem = rest_problem(scene, p["h"])
-    cfg = {"packings": p, "unger": dict(rounds=3, noise=0.5, solver=dict(tol=1e-12, max_sweeps=1, check_every=1))}
-    f, conv, rest = fg.unger_relax(scene, problem, cfg, np.random.default_rng(0))
-    assert f.shape == (4, problem.contacts.n, 2)
-    assert np.isfinite(f[0]).all() and np.isnan(f[1:]).all()
-    assert not conv.any() and not rest[1:].any()
+@pytest.fixture(scope="module")
+def frictionless_cell():
+    p = small_plates()
+    cell, forces, contacts, info = fg.build(p, 0.0, member=0)
+    return p, cell, forces, contacts, info
 
 
-def test_wedged_disc_is_unbounded():
-    """A disc held by friction between two walls facing each other (rows: F_x, F_y,
-    torque; unit weight): r_t = ±1/2, r_n1 = r_n2 >= 1 / (2 mu), unbounded above."""
-    mu = 0.5
-    H = sp.csr_matrix([[1.0, 0.0, -1.0, 0.0], [0.0, 1.0, 0.0, -1.0], [0.0, -1.0, 0.0, -1.0]])
-    m = ge.exact_measures(H, [0.0, -1.0, 0.0], mu)
-    assert not m["bounded"] and np.isnan(m["eta_exact"])
-    assert (m["dim_A"], m["dim_AC_rank"], m["dim_AC_lp"]) == (1, 1, 1)
-    np.testing.assert_allclose(m["force_min"][:, 0], 0.5 / mu, rtol=1e-9)
-    assert np.isinf(m["force_max"][:, 0]).all()
-    np.testing.assert_allclose([m["force_min"][0, 1], m["force_max"][0, 1]], [0.5, 0.5], atol=1e-9)
+def test_mobile_plate_is_balanced_and_moves_along_its_normal(frictionless_cell):
+    """At rest the plate's contacts carry exactly its load (its row of H r + F = 0), with no
+    tangential force; it has not moved sideways; the whole cell's A ∩ C is bounded."""
+    p, cell, forces, contacts, info = frictionless_cell
+    top = contacts.body_b == cell.n
+    assert top.sum() >= 2
+    assert forces[top, 0].sum() == pytest.approx(cell.force, rel=1e-9)
+    assert np.abs(forces[top, 1]).max() == 0.0
+    assert cell.scene.vel[cell.n, 0] == 0.0 and cell.scene.pos[cell.n, 0] == pytest.approx(0.5 * cell.scene.period)
+    H = h_matrix(cell.scene, contacts)
+    r = np.abs(H @ forces.ravel() + plates.external_force(cell)).max()
+    assert r <= 1e-9 * cell.force
+    assert fg.plates_bounded(cell, contacts)
+    assert info["max_penetration"] < 0.2
 
 
-def test_unger_eta_of_known_samples():
-    f0 = np.array([[1.0, 0.0], [3.0, 0.0]])
-    f1 = f0 + np.array([[0.0, 0.5], [0.0, -0.5]])
-    assert ge.unger_eta([f0, f1, f0]) == pytest.approx((0.5 + 0.0) / 2 / 2.0)
+def test_frictionless_packing_is_isostatic_and_determinate(frictionless_cell):
+    """A packing built frictionless has no self-stress: its slice (boundary forces fixed) has
+    dim (A ∩ C) = 0, every contact fixed, eta_U = 0 on the uniform sample (one point) and on
+    the random walk (every relaxation returns the history state to round-off)."""
+    p, cell, forces, contacts, _ = frictionless_cell
+    sl = fg.slice_of(cell, contacts, forces, p)
+    assert len(sl.mu) >= 5 and (sl.mu == 0).all()
+    m = ge.exact_measures(sl.H, sl.F, sl.mu, feas_tol=1e-9)
+    assert (m["dim_AC_rank"], m["dim_AC_lp"]) == (0, 0) and m["n_fixed"] == m["n_contacts"]
+    walk = gu.random_walk(sl, WALK, np.random.default_rng(0))
+    assert walk["ok"].all()
+    assert gu.eta_u(walk["samples"]) <= 1e-9
+    uni = gu.uniform_sample(sl, m, dict(per_chain=20, rounds=0), lambda k: np.random.default_rng(k), 1e-9)
+    assert uni["dimension"] == 0 and uni["eta"] == 0.0
 
 
-def test_packing_table_and_bad_friction():
-    p = dict(mu_min=0.01, mu_max=1.0, n_mu=3, kinds={"plates": 2, "box": 1})
-    t = fg.packing_table(p)
-    assert len(t["mu"]) == 9 and len(set(t["member"].tolist())) == 9
-    np.testing.assert_allclose(np.unique(t["mu"]), [0.01, 0.1, 1.0])
+def test_eta_u_of_a_uniform_segment():
+    """Two frictionless supports share a unit load: A ∩ C is the segment r_n1 + r_n2 = 1, each
+    r_n uniform on [0, 1] under the uniform law, so eta_U = (1 / sqrt 12) / (1 / 2) exactly.
+    Hit-and-run's two chains (dispersed starts) give it within sampling error, and agree."""
+    P = ForcePolytope(sp.csr_matrix([[1.0, 0.0, 1.0, 0.0]]), [-1.0], 0.0)
+    x, info = P.uniform_samples(lambda k: np.random.default_rng((k, 1)), 2, 4000, dispersed=True)
+    assert info["dimension"] == 1 and info["rhat"] < 1.02
+    f = x.reshape(2, 4000, 2, 2)
+    exact = gu.closed_form_segment_eta()
+    assert exact == pytest.approx(0.57735, abs=1e-5)
+    # 4000 thinned points per chain: the relative standard error of a standard deviation ~ 1 / sqrt(2 n) ~ 1 %
+    for chain in f:
+        assert gu.eta_u(chain) == pytest.approx(exact, rel=0.05)
+    assert gu.eta_u(f.reshape(-1, 2, 2)) == pytest.approx(exact, rel=0.03)
+
+
+def test_eta_u_is_a_standard_deviation_over_mean_force():
+    """Known samples: contact 0 alternates t = ±0.5 at n = 1, contact 1 is fixed at 3."""
+    f = np.array([[[1.0, 0.5], [3.0, 0.0]], [[1.0, -0.5], [3.0, 0.0]]] * 2)
+    sd = np.std([0.5, -0.5, 0.5, -0.5], ddof=1)
+    mag = (np.hypot(1.0, 0.5) + 3.0) / 2
+    assert gu.eta_u(f) == pytest.approx(sd / 2 / mag, rel=1e-12)
+    assert np.isnan(gu.eta_u(f[:1]))
+
+
+def test_study_tables_and_bad_friction():
+    p = small_plates(n_mu=3, per_mu=2, control=2)
+    b, a = fg.build_table(p), fg.analysis_table(p)
+    assert len(b["mu"]) == 8 and len(set(b["member"].tolist())) == 8
+    assert (b["mu"][b["kind"] == 1] == 0.0).all()
+    assert len(a["mu"]) == 6 + 2 * 3
+    np.testing.assert_allclose(np.unique(a["mu"]), [0.01, 0.1, 1.0])
     with pytest.raises(ncd.InputError, match="mu_min"):
         fg.mu_values(dict(mu_min=0.0, mu_max=1.0, n_mu=3))
-    with pytest.raises(ncd.InputError, match="kinds"):
-        fg.packing_table(dict(p, kinds={"lid": 1}))
 
 
 def test_ballistic_start_has_no_overlap():
     rng = np.random.default_rng(0)
     radius = rng.uniform(1.0, 2.0, 60)
-    pos = fg.ballistic(radius, 42.0, True, rng)
+    pos = fg.ballistic(radius, 42.0, rng)
     d = pos[:, None] - pos[None]
     d[..., 0] -= 42.0 * np.round(d[..., 0] / 42.0)
     gap = np.hypot(d[..., 0], d[..., 1]) - (radius[:, None] + radius[None])
@@ -121,30 +149,57 @@ def packings(results):
     return xr.load_dataset(results / "fig5_governing" / "packings.nc")
 
 
+CHAIN_GAP, RHAT = 0.3, 1.2      # the two uniform chains agree: eta_U within 30 %, R-hat below 1.2
+
+
+def test_two_uniform_chains_agree_on_every_packing(packings):
+    """The mixing check: on every analysis with a bounded, non-trivial A ∩ C the two
+    hit-and-run chains (dispersed starts) give eta_U within CHAIN_GAP and R-hat below RHAT."""
+    sel = (packings.bounded.values == 1) & (packings.dim_AC_rank.values > 0)
+    assert np.isfinite(packings.eta_uniform.values[packings.bounded.values == 1]).all()
+    assert (packings.eta_uniform_gap.values[sel] <= CHAIN_GAP).all(), packings.eta_uniform_gap.values[sel]
+    assert (packings.rhat.values[sel] <= RHAT).all(), packings.rhat.values[sel]
+    np.testing.assert_array_equal(packings.dim_uniform.values[sel], packings.dim_AC_rank.values[sel])
+
+
 def test_lp_dimension_agrees_with_rank_count(packings):
     assert packings.sizes["packing"] >= 6
     np.testing.assert_array_equal(packings.dim_AC_lp.values, packings.dim_AC_rank.values)
     assert (packings.dim_AC_rank.values <= packings.dim_A.values).all()
-    assert (packings.dim_AC_rank.values > 0).all()      # frictional packings: indeterminate
 
 
-def test_exact_ranges_contain_every_relaxed_solution(packings):
-    ok = packings.relaxed_ok.values == 1
-    assert ok.sum() >= packings.sizes["packing"]
+def test_walk_samples_are_inside_the_exact_ranges(packings):
+    """Every accepted random-walk state lies within the exact range of each force component."""
+    ok = packings.walk_point.values == 1
+    assert ok[:, 0].all() and ok.sum() >= 2 * packings.sizes["packing"]
     for j in range(packings.sizes["packing"]):
         k = int(packings.n_contacts[j])
-        tol = 1e-6 * np.nanmax(np.abs(packings.relaxed_n.values[j]))
+        tol = 1e-6 * np.nanmax(np.abs(packings.walk_n.values[j]))
         for comp in ("n", "t"):
-            lo = np.nan_to_num(packings[f"force_min_{comp}"].values[j, :k], nan=-np.inf)  # NaN: unbounded
+            lo = np.nan_to_num(packings[f"force_min_{comp}"].values[j, :k], nan=-np.inf)
             hi = np.nan_to_num(packings[f"force_max_{comp}"].values[j, :k], nan=np.inf)
-            f = packings[f"relaxed_{comp}"].values[j][ok[j]][:, :k]
+            f = packings[f"walk_{comp}"].values[j][ok[j]][:, :k]
             assert (f >= lo - tol).all() and (f <= hi + tol).all(), (j, comp)
 
 
-def test_eta_small_friction_below_peak(packings):
-    for k in set(packings.kind.values.tolist()):
-        t = fg.eta_table(packings, "eta_exact", k)
-        assert t[0, 1] < 0.8 * np.nanmax(t[:, 1])
+def test_claims_are_measured(results):
+    from ncd.core.verdict import VERDICTS
+    for claim in (gc.claim_unger_peak, gc.claim_unger_vanishes, gc.claim_unger_control, gc.claim_unger_centrality):
+        v = claim(results)
+        assert v.verdict in VERDICTS[:2] and v.anchor.startswith("unger-") and "nan" not in v.value
+
+
+def test_wedged_disc_is_unbounded():
+    """A disc held by friction between two walls facing each other (rows: F_x, F_y,
+    torque; unit weight): r_t = ±1/2, r_n1 = r_n2 >= 1 / (2 mu), unbounded above."""
+    mu = 0.5
+    H = sp.csr_matrix([[1.0, 0.0, -1.0, 0.0], [0.0, 1.0, 0.0, -1.0], [0.0, -1.0, 0.0, -1.0]])
+    m = ge.exact_measures(H, [0.0, -1.0, 0.0], mu)
+    assert not m["bounded"] and np.isnan(m["eta_exact"])
+    assert (m["dim_A"], m["dim_AC_rank"], m["dim_AC_lp"]) == (1, 1, 1)
+    np.testing.assert_allclose(m["force_min"][:, 0], 0.5 / mu, rtol=1e-9)
+    assert np.isinf(m["force_max"][:, 0]).all()
+    np.testing.assert_allclose([m["force_min"][0, 1], m["force_max"][0, 1]], [0.5, 0.5], atol=1e-9)
 
 
 # ---------------------------------------------------------------------------- why a line

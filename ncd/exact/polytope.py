@@ -22,8 +22,6 @@ from ncd.core.errors import InputError
 from ncd.core.jit import njit
 from ncd.exact.polygon import support_polygon
 
-_HIGHS = {"primal_feasibility_tolerance": 1e-10, "dual_feasibility_tolerance": 1e-10}
-
 
 class PolytopeError(RuntimeError):
     """``A ∩ C`` is empty, or unbounded where a bounded set is needed, or an LP failed."""
@@ -65,7 +63,7 @@ class ForcePolytope:
     equation by its largest coefficient, so the LP tolerances are relative.
     """
 
-    def __init__(self, H, F, mu):
+    def __init__(self, H, F, mu, feas_tol=1e-10):
         H = validate.matrix("H", H)
         F = validate.array("F", np.asarray(F).ravel() if np.ndim(F) > 1 else F, (None,))
         self.n_contacts = H.shape[1] // 2
@@ -86,6 +84,9 @@ class ForcePolytope:
         v = np.concatenate([np.ones(k), -np.ones(k), -np.ones(k), -self.mu, -self.mu])
         self.G = sp.csr_matrix((v, (r, c)), shape=(3 * k, 2 * k))
         self.n_lp = 0
+        # HiGHS's tolerances (relative: forces and rows are scaled); 1e-9 when F carries
+        # round-off of that order (a slice's boundary loads summed from many contacts)
+        self.highs = {"primal_feasibility_tolerance": float(feas_tol), "dual_feasibility_tolerance": float(feas_tol)}
 
     # ------------------------------------------------------------ LP basics
     def _lp(self, c, A_ub=None, b_ub=None, extra_eq=None, n_extra=0, bounds=None):
@@ -100,7 +101,7 @@ class ForcePolytope:
             b_eq = np.concatenate([b_eq, extra_eq[1]])
         self.n_lp += 1
         res = linprog(c, A_ub=A_ub, b_ub=b_ub, A_eq=A_eq, b_eq=b_eq,
-                      bounds=bounds or (None, None), method="highs", options=_HIGHS)
+                      bounds=bounds or (None, None), method="highs", options=self.highs)
         if res.status == 2:
             return None
         if res.status != 0:
@@ -125,7 +126,7 @@ class ForcePolytope:
         A_ub = sp.vstack([self.G, sp.csr_matrix(-c)]).tocsr()
         b_ub = np.concatenate([np.zeros(3 * k), [1.0]])
         res = linprog(c, A_ub=A_ub, b_ub=b_ub, A_eq=self.A_eq, b_eq=np.zeros(len(self.b_eq)),
-                      bounds=(None, None), method="highs", options=_HIGHS)
+                      bounds=(None, None), method="highs", options=self.highs)
         self.n_lp += 1
         if res.status != 0:
             raise PolytopeError(f"boundedness LP failed: {res.message}")
@@ -166,16 +167,19 @@ class ForcePolytope:
                                dirs, tol * self.scale, max_lp, self.scale)
 
     # ------------------------------------------------------------ uniform sampling
-    def affine_hull(self, tol=1e-9):
+    def affine_hull(self, tol=1e-9, implicit=None):
         """Point, orthonormal basis and reduced inequalities of the affine hull of ``A ∩ C``.
 
         Coulomb rows that no point of ``A ∩ C`` satisfies strictly (implicit
         equalities, e.g. a contact forced to slide or to carry no force) are
-        moved to the equalities.  Returns ``(x0, Z, Gz, b, implicit)`` in scaled units.
+        moved to the equalities.  ``implicit`` (bool per row of ``G``), when known
+        (e.g. from :func:`ncd.figures.governing_exact.implicit_rows`), starts the search,
+        which then needs one LP when it is complete.  Returns ``(x0, Z, Gz, b, implicit)``
+        in scaled units.
         """
         G = self.G.toarray()
         m, n = G.shape
-        implicit = np.zeros(m, bool)
+        implicit = np.zeros(m, bool) if implicit is None else np.array(implicit, bool).reshape(m)
         # one LP: maximize the smallest slack t (capped at 1) of rows not yet known to be tight
         while True:
             rows = ~implicit
@@ -206,12 +210,17 @@ class ForcePolytope:
         keep = np.hypot.reduce(Gz, axis=1) > 1e-12 if Gz.size else np.zeros(0, bool)
         return x0, Z, Gz[keep], b[keep], implicit
 
-    def uniform_samples(self, rng_of, n_chains, per_chain, thin=None, burn=None, rounds=2):
+    def uniform_samples(self, rng_of, n_chains, per_chain, thin=None, burn=None, rounds=2, implicit=None,
+                        dispersed=False):
         """Points drawn uniformly from ``A ∩ C`` (forces, shape (n_chains * per_chain, 2 kappa)).
 
         Hit-and-run in the affine hull of ``A ∩ C`` from its Chebyshev centre,
         with directions shaped by the covariance of ``rounds`` pilot chains
         (any symmetric direction law keeps the uniform law stationary).
+        ``dispersed``: chain ``k`` starts instead 95 % of the way from the centre to the
+        vertex maximizing a random direction (drawn from ``rng_of(k)``), so that chains
+        that agree have forgotten different starts (a mixing check).  ``implicit``: known
+        implicit equalities (:meth:`affine_hull`).
         ``rng_of(k)`` is the generator of chain ``k``; pilots use ``n_chains + r``.
         Returns ``(samples, info)``; ``info`` has the dimension, the implicit
         equalities and the largest Gelman-Rubin R-hat over coordinates.
@@ -225,7 +234,7 @@ class ForcePolytope:
             raise InputError(f"rng_of must be a callable k -> numpy Generator; got {rng_of!r}")
         if not self.is_bounded():
             raise PolytopeError("A ∩ C is unbounded: there is no uniform law on it")
-        x0, Z, Gz, b, implicit = self.affine_hull()
+        x0, Z, Gz, b, implicit = self.affine_hull(implicit=implicit)
         d = Z.shape[1]
         if d == 0:
             pts = np.tile(x0 * self.scale, (n_chains * per_chain, 1))
@@ -234,7 +243,7 @@ class ForcePolytope:
         c = np.zeros(d + 1)
         c[-1] = -1.0
         res = linprog(c, A_ub=np.hstack([Gz, norms[:, None]]), b_ub=b, bounds=[(None, None)] * (d + 1),
-                      method="highs", options=_HIGHS)
+                      method="highs", options=self.highs)
         if res.status != 0 or res.x[-1] <= 0:
             raise PolytopeError("A ∩ C has an empty relative interior")
         y0 = res.x[:d]
@@ -242,8 +251,15 @@ class ForcePolytope:
         burn = burn or 50 * d
         L = np.eye(d) * res.x[-1]
 
+        def start(rng):
+            if not dispersed:
+                return y0.copy()
+            v = linprog(-rng.standard_normal(d), A_ub=Gz, b_ub=b, bounds=[(None, None)] * d, method="highs",
+                        options=self.highs)
+            return y0 + 0.95 * (v.x - y0) if v.status == 0 else y0.copy()
+
         def chain(rng, n_keep, L):
-            y = y0.copy()
+            y = start(rng)
             blocks = [max(burn // thin, 1)] + [min(1000, n_keep - k) for k in range(0, n_keep, 1000)]
             keep = []
             for n in blocks:                                  # the first block is burn-in

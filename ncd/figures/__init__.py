@@ -13,6 +13,6 @@ FIGURE_MODULES = {
     "fig4_pile": ("pile", "pile_exact", "pile_plots"),
     "fig4_history": ("history", "history_analysis", "history_exact", "history_plots", "history_size"),
     "fig4_bank": ("bank", "bank_claims", "bank_exact", "bank_plots"),
-    "fig5_governing": ("governing", "governing_exact", "governing_flow", "governing_line", "governing_plot",
-                       "governing_summary"),
+    "fig5_governing": ("governing", "governing_claims", "governing_exact", "governing_flow", "governing_line",
+                       "governing_plot", "governing_summary", "governing_unger"),
 }

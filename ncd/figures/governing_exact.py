@@ -166,13 +166,14 @@ def lp_dimension(model, points, basis, tol, max_rounds=200):
     return r, flat
 
 
-def exact_measures(H, F, mu, width_tol=1e-7, slack_tol=1e-9):
-    """Every exact measure of one packing -> dict (forces in force units)."""
-    P = ForcePolytope(H, F, mu)
+def exact_measures(H, F, mu, width_tol=1e-7, slack_tol=1e-9, feas_tol=1e-10):
+    """Every exact measure of one packing -> dict (forces in force units); ``feas_tol``:
+    HiGHS's relative feasibility tolerance."""
+    P = ForcePolytope(H, F, mu, feas_tol)
     k = P.n_contacts
     Hd = P.A_eq.toarray()
     rank_h = _rank(Hd)
-    model = _Model(P)
+    model = _Model(P, feas_tol)
     out = {"n_contacts": k, "rank_H": rank_h, "dim_A": 2 * k - rank_h, "n_equations": Hd.shape[0],
            "scale": P.scale}
     model.base = model.minimize(np.zeros(2 * k))
@@ -195,18 +196,9 @@ def exact_measures(H, F, mu, width_tol=1e-7, slack_tol=1e-9):
     finite = out["bounded"]
     out.update(
         force_min=lo * P.scale, force_max=hi * P.scale, fixed=fixed, n_fixed=int(fixed.sum()),
-        implicit_zero=implicit[2 * k:], implicit_sliding=implicit[:k] | implicit[k:2 * k],
+        implicit=implicit, implicit_zero=implicit[2 * k:], implicit_sliding=implicit[:k] | implicit[k:2 * k],
         eta_exact=float(np.hypot(width[:, 0], width[:, 1]).sum() / np.hypot(mid[:, 0], mid[:, 1]).sum())
         if finite else np.nan,
         eta_normal=float(width[:, 0].sum() / np.abs(mid[:, 0]).sum()) if finite else np.nan,
         n_lp=model.n_lp + P.n_lp)
     return out
-
-
-def unger_eta(forces):
-    """Unger et al.'s measure from relaxed solutions ``forces`` (samples, contacts, 2),
-    the first the starting solution: ``<|F_k - F_0|> / <|F_0|>`` averaged over contacts,
-    then over samples ``k >= 1``."""
-    f = np.asarray(forces, float)
-    d = np.hypot(*(f[1:] - f[:1]).transpose(2, 0, 1)).mean(axis=1)
-    return float(d.mean() / np.hypot(f[0, :, 0], f[0, :, 1]).mean())

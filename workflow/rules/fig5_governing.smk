@@ -1,15 +1,14 @@
-# Figure 5: what governs indeterminacy — static packings across friction,
-# measured exactly (LPs on A ∩ C) and Unger, Kertész & Wolf's way (noise + NLGS).
-#   pack      packings of one shard built by contact dynamics  -> shards/packs_<k>-of-<n>.nc
-#   exact     exact measures of A ∩ C (HiGHS LPs)              -> shards/exact_<k>-of-<n>.nc
-#   unger     noise + NLGS relaxations (exploration)           -> shards/unger_<k>-of-<n>.nc
-#   merge     every shard of the three                         -> packings.nc
+# Figure 5: what governs indeterminacy — static packings across friction in Unger, Kertész &
+# Wolf's geometry (two plates, the top one mobile, no gravity), a middle slice measured exactly
+# (LPs on A ∩ C), sampled by their random walk and uniformly (hit-and-run).
+#   pack      builds of one shard by contact dynamics           -> shards/packs_<k>-of-<n>.nc
+#   analyse   analyses of one shard (every build read)          -> shards/analyses_<k>-of-<n>.nc
+#   merge     every shard of both                               -> packings.nc
 #   deposit, flow, flows (below): Figure 2's flow across mu, h, slope  -> flows.nc
 #   notebook  notebooks/fig5_governing.ipynb                    -> results/figures/fig5_governing.png|pdf
 FIG = "fig5_governing"
 CFG = section(FIG)
 F5 = f"results/{FIG}"
-F5_STAGES = ("packs", "exact", "unger")
 
 
 rule fig5_governing_pack:
@@ -32,51 +31,31 @@ rule fig5_governing_pack:
         "../scripts/fig5_governing_pack.py"
 
 
-rule fig5_governing_exact:
+rule fig5_governing_analyse:
     input:
         ncd_sources(FIG),
-        packs=f"{F5}/shards/packs_{{shard}}-of-{{n}}.nc",
+        packs=shard_files(FIG, "packs", CFG["shards"]),
     output:
-        temp(f"{F5}/shards/exact_{{shard}}-of-{{n}}.nc"),
+        temp(f"{F5}/shards/analyses_{{shard}}-of-{{n}}.nc"),
     wildcard_constraints:
         shard=r"\d+",
         n=r"\d+",
     params:
         config=without_shards(CFG),
     log:
-        log(FIG, "exact_{shard}-of-{n}"),
+        log(FIG, "analyse_{shard}-of-{n}"),
     benchmark:
-        bench(FIG, "exact_{shard}-of-{n}")
+        bench(FIG, "analyse_{shard}-of-{n}")
     conda:
         CONDA_ENV
     script:
-        "../scripts/fig5_governing_exact.py"
-
-
-rule fig5_governing_unger:
-    input:
-        ncd_sources(FIG),
-        packs=f"{F5}/shards/packs_{{shard}}-of-{{n}}.nc",
-    output:
-        temp(f"{F5}/shards/unger_{{shard}}-of-{{n}}.nc"),
-    wildcard_constraints:
-        shard=r"\d+",
-        n=r"\d+",
-    params:
-        config=without_shards(CFG),
-    log:
-        log(FIG, "unger_{shard}-of-{n}"),
-    benchmark:
-        bench(FIG, "unger_{shard}-of-{n}")
-    conda:
-        CONDA_ENV
-    script:
-        "../scripts/fig5_governing_unger.py"
+        "../scripts/fig5_governing_analyse.py"
 
 
 rule fig5_governing_merge:
     input:
-        **{s: shard_files(FIG, s, CFG["shards"]) for s in F5_STAGES},
+        packs=shard_files(FIG, "packs", CFG["shards"]),
+        analyses=shard_files(FIG, "analyses", CFG["shards"]),
     output:
         f"{F5}/packings.nc",
     log:
@@ -97,8 +76,12 @@ rule fig5_governing_notebook:
         notebook_py=notebook_file(FIG, "py"),
         pages=page_sources("notebook"),
     output:
-        png=figure_output(FIG, "png"),
-        pdf=figure_output(FIG, "pdf"),
+        # the report's caption is the finding, written by the notebook from the data
+        png=report(f"results/figures/{FIG}.png", caption=os.path.abspath(f"{F5}/caption.rst"), category=FIG,
+                   subcategory="PNG"),
+        pdf=report(f"results/figures/{FIG}.pdf", caption=os.path.abspath(f"{F5}/caption.rst"), category=FIG,
+                   subcategory="PDF"),
+        caption=f"{F5}/caption.rst",
     params:
         config=without_shards(CFG),
     log:

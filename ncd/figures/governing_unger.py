@@ -1,0 +1,119 @@
+"""Unger, Kertész & Wolf's indeterminacy, their way and on a uniform sample.
+
+Their measure (PRL 94, 178001, 2005): ``eta_U = <dF> / <|F|>``, where for each contact
+``dF`` is the standard deviation of its force vector over the sampled solutions
+(``dF^2 = var F_n + var F_t``) and ``<.>`` averages over contacts (:func:`eta_u`).  Two
+samples of the same set ``A ∩ C`` of a slice (:mod:`ncd.scenes.plates`):
+
+* their random walk (:func:`random_walk`): every force component of the current solution
+  gets uniform noise in ``[-a, a]``, ``a = noise * <F_n>``, NLGS relaxes it with random
+  review order (boundary forces fixed) and the result, checked to be a point of ``A ∩ C``,
+  starts the next round.  A walk stays near where it starts, so ``eta_U`` against the
+  number of samples (:func:`eta_curve`) shows whether it has settled;
+* a uniform sample (:func:`uniform_sample`): hit-and-run in the affine hull of ``A ∩ C``
+  (:meth:`ncd.exact.polytope.ForcePolytope.uniform_samples`, implicit equalities found by
+  the exact LPs, directions rounded by pilot chains) from two dispersed starts; the two
+  chains' ``eta_U`` and the Gelman-Rubin R-hat say whether they mixed.
+
+:func:`centrality` measures their last finding: the history (build) state lies closer to
+the centre of the set than random samples do.
+"""
+import numpy as np
+
+from ncd.exact.polytope import ForcePolytope
+from ncd.scenes.plates import relax
+from ncd.solver.settings import SolverSettings
+
+
+def eta_u(samples):
+    """``<dF> / <|F|>`` of samples (n_samples, contacts, 2): ``dF`` the per-contact standard
+    deviation of the force vector over the samples, ``<|F|>`` the mean force magnitude."""
+    f = np.asarray(samples, float)
+    if len(f) < 2:
+        return np.nan
+    d = f - f[:1]                  # shifted by the first sample: identical samples give exactly 0
+    dF = np.sqrt(d[..., 0].var(axis=0, ddof=1) + d[..., 1].var(axis=0, ddof=1))
+    mag = np.hypot(f[..., 0], f[..., 1]).mean()
+    return float(dF.mean() / mag) if mag > 0 else np.nan
+
+
+def eta_curve(samples, counts):
+    """``eta_U`` over the first ``n`` samples, for each ``n`` of ``counts``."""
+    return np.array([eta_u(samples[:n]) for n in counts])
+
+
+def random_walk(sl, w, rng):
+    """Unger et al.'s random walk in ``A ∩ C`` of slice ``sl`` from its history state.
+
+    Returns ``samples`` (w["samples"] + 1, kappa, 2; row 0 the history state) and ``ok``
+    (bool per row: the relaxed forces are a point of ``A ∩ C`` within ``point_tol`` of the
+    force scale; a failed round leaves the walk where it was)."""
+    P = ForcePolytope(sl.H, sl.F, sl.mu)
+    settings = SolverSettings(**w["solver"])
+    k = len(sl.mu)
+    cur = sl.reference.copy()
+    out = np.full((w["samples"] + 1, k, 2), np.nan)
+    ok = np.zeros(w["samples"] + 1, bool)
+    out[0], ok[0] = cur, _is_point(P, cur, w["point_tol"])
+    a = w["noise"] * float(np.mean(cur[:, 0])) if k else 0.0
+    for s in range(1, w["samples"] + 1):
+        guess = cur + rng.uniform(-a, a, (k, 2))
+        r, _, _ = relax(sl, guess, rng.permutation(k), settings)
+        out[s] = r
+        ok[s] = _is_point(P, r, w["point_tol"])
+        if ok[s]:
+            cur = r
+    return {"samples": out, "ok": ok}
+
+
+def _is_point(P, r, tol):
+    if P.n_contacts == 0:
+        return True
+    eq, co = P.violations(np.asarray(r).ravel())
+    return bool(eq[0] <= tol and co[0] <= tol)
+
+
+def uniform_sample(sl, exact, u, rng_of, feas_tol=1e-10):
+    """Two hit-and-run chains of ``u["per_chain"]`` points from dispersed starts, uniform on
+    ``A ∩ C`` of slice ``sl`` (``exact``: its :func:`exact_measures`, for the implicit
+    equalities).  Returns the pooled samples (2 per_chain, kappa, 2), per-chain means and
+    standard deviations (2, kappa, 2), ``eta`` (pooled), ``gap`` (|eta_1 - eta_2| / eta),
+    ``rhat`` and the dimension."""
+    P = ForcePolytope(sl.H, sl.F, sl.mu, feas_tol)
+    k = P.n_contacts
+    x, info = P.uniform_samples(rng_of, 2, u["per_chain"], rounds=u["rounds"], implicit=exact["implicit"],
+                                dispersed=True)
+    x = x.reshape(2, u["per_chain"], k, 2)
+    etas = [eta_u(c) for c in x]
+    eta = eta_u(x.reshape(-1, k, 2))
+    gap = abs(etas[0] - etas[1]) / eta if eta > 0 else 0.0
+    return {"samples": x.reshape(-1, k, 2), "chain_mean": x.mean(axis=1), "chain_std": x.std(axis=1, ddof=1),
+            "eta": eta, "eta_chains": etas, "gap": float(gap), "rhat": float(info["rhat"]),
+            "dimension": int(info["dimension"])}
+
+
+def _distance(x, centre, scale):
+    d = np.asarray(x) - centre
+    return np.sqrt((d ** 2).sum(axis=(-1, -2)) / centre.shape[0]) / scale
+
+
+def centrality(history, uniform, walk):
+    """Distances to the centre of ``A ∩ C`` (the uniform sample's mean), per contact (RMS)
+    over the mean force: of the history state, mean of the uniform and of the walk samples,
+    and the fraction of uniform samples closer to the centre than the history state."""
+    centre = uniform.mean(axis=0)
+    scale = float(np.hypot(centre[:, 0], centre[:, 1]).mean()) or 1.0
+    dh = float(_distance(history, centre, scale))
+    du = _distance(uniform, centre, scale)
+    dw = _distance(walk[1:], centre, scale) if len(walk) > 1 else np.array([np.nan])
+    return {"history_distance": dh, "uniform_distance": float(du.mean()), "walk_distance": float(np.mean(dw)),
+            "history_rank": float(np.mean(du < dh))}
+
+
+def closed_form_segment_eta():
+    """``eta_U`` of the uniform law on the segment ``r_n1 + r_n2 = 1`` (frictionless): each
+    ``r_n`` uniform on [0, 1], standard deviation ``1 / sqrt(12)``, mean 1/2: ``2 / sqrt(12)``."""
+    return 2.0 / np.sqrt(12.0)
+
+
+__all__ = ["eta_u", "eta_curve", "random_walk", "uniform_sample", "centrality", "closed_form_segment_eta"]
