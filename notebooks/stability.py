@@ -96,9 +96,8 @@ display(Markdown(claim_markdown("s2-restitution", results, "stability")))
 # Measured per case (steps $h$ in seconds):
 
 # %%
-display(Markdown(page.case_notes(tab)))
-display(HTML("<details><summary>Runs per case and method (click to show)</summary>"
-             + page.summary_table(tab).to_html(index=False) + "</details>"))
+display(Markdown(page.case_notes(tab) + "\n\nRuns per case and method:"))
+display(HTML(page.summary_table(tab).to_html(index=False)))
 
 # %% [markdown]
 # **MD.** Symplectic Euler is stable for an undamped spring iff $h\omega < 2$; a dashpot

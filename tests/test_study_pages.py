@@ -109,7 +109,7 @@ def test_stability_observable_label_says_it_holds_a_value(results):
     assert re.search(r"speed", tab.observable.attrs["long_name"])
 
 
-@pytest.mark.parametrize("name", ["stability"])
+@pytest.mark.parametrize("name", ["stability", "error_vs_runtime"])
 def test_study_notebook_is_short(name):
     """A page's notebook holds a few lines per cell; its analysis and plots live in the package."""
     from pathlib import Path
@@ -118,3 +118,84 @@ def test_study_notebook_is_short(name):
     code = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
     assert len(code) <= 120
     assert "print(" not in text
+
+
+# ------------------------------------------------------------------ error against run time
+def small_nlgs():
+    """Two states, two guesses, two criteria, three tolerances; the warm start saves 4x on
+    ``rest`` and costs 2x on ``flow``; the limits of ``rest`` differ in impulses only."""
+    tol = np.array([1e-2, 1e-4, 1e-6])
+    zero = np.array([10.0, 30.0, 50.0])
+    sweeps = np.empty((2, 2, 2, 3))
+    sweeps[0, 0], sweeps[0, 1] = zero, zero / 4          # rest: zero, warm
+    sweeps[1, 0], sweeps[1, 1] = zero, zero * 2          # flow
+    err = np.broadcast_to(tol, sweeps.shape) * 3.0
+    dims = ("state", "init", "criterion", "tol")
+    return xr.Dataset(
+        {"sweeps": (dims, sweeps), "wall_time": (dims, sweeps * 1e-5), "residual": (dims, err / 3),
+         "error_impulse": (dims, err), "error_velocity": (dims, err), "converged": (dims, np.ones(sweeps.shape, int)),
+         "n_discs": ("state", [28, 160]), "n_contacts": ("state", [51, 215]),
+         "limits_distance_impulse": ("state", [0.4, 1e-11]), "limits_distance_velocity": ("state", [1e-12, 1e-10])},
+        coords={"state": ["rest", "flow"], "init": ["zero", "warm"], "criterion": ["residual", "change"], "tol": tol},
+        attrs={"config_yaml": "nlgs: {reference: {tol: 1.0e-13}}"})
+
+
+def small_integration():
+    import pandas as pd
+
+    rows = []
+    for method, h, err, wall, k in (("CD", 1e-3, 1e-15, 0.1, 0.0), ("CD", 1e-2, 0.0, 0.01, 0.0),
+                                    ("MD", 1e-5, 1e-3, 0.01, 1.0), ("MD", 1e-6, 1e-5, 0.1, 100.0)):
+        rows.append(dict(observable="incline", quantity="distance", method=method, mu=0.05, angle=20.0, h=h,
+                         h_over_hcrit=0.1, k_factor=k, value=1.0, reference=1.0, error=err, wall_time=wall,
+                         work=10.0, diverged=0))
+    for method, err, wall in (("CD", 1e-9, 0.5), ("MD", 1e-2, 0.05)):
+        rows.append(dict(observable="heap", quantity="reaction", method=method, mu=0.5, angle=0.0, h=1e-3,
+                         h_over_hcrit=0.1, k_factor=1.0 if method == "MD" else 0.0, value=1.0, reference=1.0,
+                         error=err, wall_time=wall, work=10.0, diverged=0))
+    for method, err in (("CD_reference", 0.0), ("CD_reference_check", 0.02), ("CD", 0.05), ("MD", 0.1)):
+        rows.append(dict(observable="slope_flow", quantity="mean_velocity", method=method, mu=0.5, angle=24.0,
+                         h=1e-3, h_over_hcrit=0.1, k_factor=1.0 if method == "MD" else 0.0, value=1.0,
+                         reference=1.0, error=err, wall_time=0.1, work=10.0, diverged=0))
+    return pd.DataFrame(rows)
+
+
+def test_warm_start_saving_is_read_both_ways():
+    from ncd.studies import work_precision_page as WP
+
+    nl = small_nlgs()
+    assert np.allclose(WP.sweep_ratios(nl).sel(state="rest"), 4.0)
+    text = WP.nlgs_sentences(nl)
+    assert "the warm start needs from 4 times fewer sweeps" in text
+    assert "2 times more sweeps" in text
+    assert "(tolerance 1e-13) differ by 4.0e-01 in impulses" in text
+    assert text.count("the step's forces are indeterminate") == 1      # rest only: flow's limits agree
+    assert "12 of 12" not in text and "24 of 24 settings converged" in text
+
+
+def test_integration_sentences_and_tables():
+    from ncd.studies import work_precision_page as WP
+
+    df = small_integration()
+    text = WP.integration_sentences(df)
+    assert "CD's relative error is at most 1e-15" in text and "MD's runs from 0.001 down to 1e-05" in text
+    assert "moves its mean velocity by 0.02" in text and "CD 0.05 (h = 1e-03 s); MD 0.1–0.1" in text
+    assert len(WP.integration_table(df)) == len(df)
+    assert len(WP.nlgs_table(small_nlgs())) == 24
+
+
+def test_work_precision_figure_is_readable():
+    from ncd.studies import work_precision_page as WP
+
+    assert problems(WP.plot(small_nlgs(), small_integration())) == []
+
+
+def test_work_precision_page_on_the_run(results):
+    from ncd.studies import work_precision_page as WP
+
+    nl = xr.load_dataset(results / "error_vs_runtime" / "nlgs.nc")
+    df = xr.load_dataset(results / "error_vs_runtime" / "integration.nc").to_dataframe()
+    assert problems(WP.plot(nl, df)) == []
+    r = WP.sweep_ratios(nl)
+    for st in nl.state.values:                      # the sentence quotes the extremes of the ratio
+        assert f"{float(r.sel(state=st).max()):.2g} times fewer" in WP.nlgs_sentences(nl)
