@@ -60,6 +60,10 @@ def build(kind, p, seed=0):
     return s, info
 
 
+OBSERVABLE_LABEL = ("value of the case's observable: largest displacement / r (stack, hexagonal), final "
+                    "E_kin / (M g d) (box), last disc's speed / striker's speed (chain), tunnelled 0 or 1 (impacts)")
+
+
 def observable(kind, s0, s):
     """The case's observable and its reference value (``s0`` the initial scene).
 
@@ -215,6 +219,8 @@ def to_dataset(rows, n_trace):
     ds["sweeps_mean"].attrs["description"] = "mean NLGS sweeps per step (CD); -1 for MD"
     ds["residual_max"].attrs["description"] = "largest NLGS relative natural-map residual (CD); -1 for MD"
     ds["max_penetration"].attrs["description"] = "largest interpenetration / smallest radius"
+    ds["observable"].attrs["description"] = OBSERVABLE_LABEL
+    ds["observable_ref"].attrs["description"] = "value of the case's observable for the exact motion"
     return ds
 
 

@@ -46,8 +46,8 @@ NCD_CORE = sorted([str(REL / "ncd" / "__init__.py")]
                   + [str(REL / p.relative_to(ROOT)) for layer in LOWER_LAYERS
                      for p in (ROOT / "ncd" / layer).glob("*.py")])
 STUDY_MODULES = {
-    "stability": ("stability.py", "scenes.py"),
-    "error_vs_runtime": ("work_precision.py", "scenes.py"),
+    "stability": ("stability.py", "scenes.py", "stability_page.py"),
+    "error_vs_runtime": ("work_precision.py", "scenes.py", "work_precision_page.py"),
     "bench": ("bench.py", "peer.py", "finish_bench.py", "c_sweep.c"),
 }
 # the page modules a page rule reads (notebook helpers, the HTML renderer, the index page)
@@ -57,12 +57,22 @@ PAGE_MODULES = {"notebook": ("notebook.py", "claims.py", "paper_claims.yaml"), "
 
 
 def ncd_sources(figure):
-    """Input files of a figure's computing rules: the lower layers and the figure's own modules."""
+    """Input files of a figure's computing rules: the lower layers and the figure's own modules
+    except its page modules (``*_page.py``: the figure, sentences and tables of its page)."""
     if figure in FIGURE_MODULES:
         own = ["figures/__init__.py"] + [f"figures/{m}.py" for m in FIGURE_MODULES[figure]]
     else:
         own = ["studies/__init__.py"] + [f"studies/{m}" for m in STUDY_MODULES[figure]]
-    return NCD_CORE + [str(REL / "ncd" / m) for m in own]
+    return NCD_CORE + [str(REL / "ncd" / m) for m in own if not m.endswith("_page.py")]
+
+
+def page_modules(figure):
+    """The page modules of a figure (``*_page.py`` among its modules): inputs of its notebook rule."""
+    if figure in FIGURE_MODULES:
+        own = [f"figures/{m}.py" for m in FIGURE_MODULES[figure]]
+    else:
+        own = [f"studies/{m}" for m in STUDY_MODULES[figure]]
+    return [str(REL / "ncd" / m) for m in own if m.endswith("_page.py")]
 
 
 def page_sources(kind):

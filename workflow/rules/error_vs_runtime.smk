@@ -44,6 +44,7 @@ rule error_vs_runtime_notebook:
     input:
         nlgs="results/error_vs_runtime/nlgs.nc",
         integration="results/error_vs_runtime/integration.nc",
+        page=page_modules(FIG),
         notebook=notebook_file("error_vs_runtime"),
         notebook_py=notebook_file("error_vs_runtime", "py"),
         pages=page_sources("notebook"),

@@ -25,6 +25,7 @@ rule stability_simulate:
 rule stability_notebook:
     input:
         table="results/stability/table.nc",
+        page=page_modules(FIG),
         notebook=notebook_file("stability"),
         notebook_py=notebook_file("stability", "py"),
         pages=page_sources("notebook"),
