@@ -102,9 +102,11 @@ def text_layout(fig, tol_px=1.0):
     """What a reader meets in ``fig``'s texts: ``overlaps`` (pairs of texts whose boxes
     intersect by more than ``tol_px`` pixels each way at the figure's dpi), ``min_font_pt``,
     ``dpi`` and the figure's ``width_in``.  Text over data is not detected."""
+    from matplotlib.text import Text
+
     texts = drawn_texts(fig)
     renderer = fig.canvas.get_renderer()
-    boxes = [t.get_window_extent(renderer) for t in texts]
+    boxes = [Text.get_window_extent(t, renderer) for t in texts]       # an annotation's text, not its arrow
     over = []
     for i in range(len(texts)):
         for j in range(i + 1, len(texts)):
