@@ -36,13 +36,14 @@ import xarray as xr
 from IPython.display import Markdown, display
 
 from ncd.figures import equilibrium_plots as ep
-from ncd.pages.notebook import paths, save
+from ncd.pages.notebook import paths, save, write_finding
 
 # Snakemake's object, or by hand (from the repository or notebooks/) the files under results/
 _smk = paths("fig3_equilibrium", ["state", "ensemble", "projection", "uniform"], globals().get("snakemake"))
 inp, out = _smk.input, _smk.output
 r = ep.Fig3Run(*(xr.load_dataset(getattr(inp, n)) for n in ("state", "ensemble", "projection", "uniform")))
 save(ep.figure(r), out, dpi=130, show=True)
+write_finding(out, ep.finding(r))
 
 # %% [markdown]
 # **(a)** The packing (line widths: normal forces at rest) with the two displayed

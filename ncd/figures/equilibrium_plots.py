@@ -245,3 +245,14 @@ def faces_text(r):
     u = r.faces["uniform"]
     return (faces.face_text(r.faces) + f" Of the {u['runs']} points of the uniform sample, {u['interior']} are "
             "interior (face dimension " f"{u['dimension']}).")
+
+
+def finding(r):
+    """The figure's finding in a few sentences (the Snakemake report's caption includes it)."""
+    cov = {m: [x["coverage"] for x in r.rows if x["mode"] == m] for m in ("zero", "random")}
+    z = r.faces["zero"]
+    return (f"On the displayed contacts the zero-guess clouds (the paper's exploration) cover "
+            f"{', '.join(f'{c:.1%}' for c in cov['zero'])} of the exact projections of A ∩ C, random guesses "
+            f"{', '.join(f'{c:.1%}' for c in cov['random'])}. {z['runs'] - z['interior']} of the {z['runs']} "
+            f"zero-guess solutions lie on a proper face of A ∩ C (dimension {z['dimension']}), where a uniform "
+            "point lies with probability zero.")

@@ -70,8 +70,18 @@ def paths(figure, inputs, smk=None, data_dir=None):
     return SimpleNamespace(
         input=SimpleNamespace(**{n: str(results / (data_dir or figure) / f"{n}.nc") for n in inputs}),
         output=SimpleNamespace(png=str(results / "figures" / f"{figure}.png"),
-                               pdf=str(results / "figures" / f"{figure}.pdf")),
+                               pdf=str(results / "figures" / f"{figure}.pdf"),
+                               finding=str(results / "figures" / f"{figure}.finding.rst")),
         params=SimpleNamespace(config=section), config={figure: section})
+
+
+def write_finding(output, text):
+    """Write the figure's finding (a paragraph computed from the data) to ``output.finding``:
+    the Snakemake report's caption ``workflow/report/<figure>.rst`` includes it."""
+    path = getattr(output, "finding", None)
+    if path is not None:
+        Path(path).parent.mkdir(parents=True, exist_ok=True)
+        Path(path).write_text(" ".join(text.split()) + "\n", encoding="utf-8")
 
 
 def drawn_texts(fig):

@@ -122,6 +122,7 @@ rule fig3_equilibrium_notebook:
     output:
         png=figure_output(FIG, "png"),
         pdf=figure_output(FIG, "pdf"),
+        finding=f"results/figures/{FIG}.finding.rst",   # included by the report's caption
     params:
         config=without_shards(CFG),
     log:
