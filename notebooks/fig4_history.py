@@ -52,7 +52,7 @@ import xarray as xr
 from IPython.display import Markdown, display
 
 from ncd.figures import history_plots as hp
-from ncd.pages.notebook import save
+from ncd.pages.notebook import save, write_finding
 
 try:
     snakemake  # noqa: F821 (injected by Snakemake's notebook directive)
@@ -66,13 +66,15 @@ except NameError:  # by hand, from the repository root after `snakemake -j2 fig4
     inp = SimpleNamespace(analysis=f"results/fig4_history/analysis_n{n}.nc",
                           point=f"results/fig4_history/piles/n{n}/point_000.nc",
                           rain=f"results/fig4_history/piles/n{n}/rain_000.nc")
-    out = SimpleNamespace(png="results/figures/fig4_history.png", pdf="results/figures/fig4_history.pdf")
+    out = SimpleNamespace(png="results/figures/fig4_history.png", pdf="results/figures/fig4_history.pdf",
+                          finding="results/figures/fig4_history.finding.rst")
 an = xr.load_dataset(inp.analysis)
 piles = [xr.load_dataset(inp.point), xr.load_dataset(inp.rain)]
 s = hp.summary(an)
 
 # %%
 save(hp.figure(an, piles), out, dpi=130, show=True)
+write_finding(out, hp.finding(an))
 
 # %% [markdown]
 # **(a)** Member 0 of each history (the same grains). **(b)** Mean ground stress over

@@ -39,6 +39,7 @@ import xarray as xr
 from IPython.display import Markdown, display
 
 from ncd.figures import history_size as hs
+from ncd.pages.notebook import save, write_finding
 
 try:
     snakemake  # noqa: F821 (injected by Snakemake's notebook directive)
@@ -46,18 +47,19 @@ try:
 except NameError:  # by hand, from the repository root after `snakemake -j2 fig4_history_size`
     from types import SimpleNamespace
     inp = SimpleNamespace(sizes="results/fig4_history/size.nc")
-    out = SimpleNamespace(png="results/figures/fig4_history_size.png", pdf="results/figures/fig4_history_size.pdf")
+    out = SimpleNamespace(png="results/figures/fig4_history_size.png", pdf="results/figures/fig4_history_size.pdf",
+                          finding="results/figures/fig4_history_size.finding.rst")
 sz = xr.load_dataset(inp.sizes)
 s = hs.summary(sz)
 
 # %%
-fig = hs.figure(sz)
-fig.savefig(out.png, dpi=130)
-fig.savefig(out.pdf, metadata={"CreationDate": None})
+save(hs.figure(sz), out, dpi=130, show=True)
+write_finding(out, hs.finding(sz))
 
 # %% [markdown]
-# **(a)** Dip depth of the mean ground-stress profile (bars: 95 % bootstrap band over
-# piles) against the grains per pile. **(b)** Arching: per pile, the median deviation of
+# **(a)** Dip depth $M - m$ of the mean ground-stress profile, in units of the mean
+# stress $W / 2L$ (> 0 a dip; bars: 95 % bootstrap band over piles) against the grains
+# per pile. **(b)** Arching: per pile, the median deviation of
 # the cut resultant from the flank slope, averaged over piles (bars: bootstrap band).
 # **(c)** Flank slope. **(d)** Median deviation over piles against the cut position, per
 # size (dashed: the smaller).
@@ -76,7 +78,7 @@ head = ("| history | " + " | ".join(f"dip, {n} grains" for n in g) + " | "
         + " | ".join(f"arching, {n} grains" for n in g) + " | " + " | ".join(f"flank, {n} grains" for n in g) + " |")
 display(Markdown(f"""
 **What we measured.** {piles[0]} piles per history of {g[0]} grains and {piles[-1]} of {g[-1]}
-(dip: kernel {s['kernel']:g} d; brackets: 95 % bootstrap bands over piles):
+(dip depth $M - m$ of the mean profile in units of $W / 2L$, > 0 a dip, kernel {s['kernel']:g} d; brackets: 95 % bootstrap bands over piles):
 
 {head}
 |{'---|' * (1 + 3 * len(g))}

@@ -39,7 +39,7 @@ import xarray as xr
 from IPython.display import Markdown, display
 
 from ncd.figures import pile_plots as pp
-from ncd.pages.notebook import paths, save
+from ncd.pages.notebook import paths, save, write_finding
 
 # Snakemake's object, or by hand (from the repository or notebooks/) the files under results/
 _smk = paths("fig4_pile", ["construction", "cuts", "ensemble", "tolerance", "exact"], globals().get("snakemake"))
@@ -47,6 +47,7 @@ inp, out, cfg = _smk.input, _smk.output, _smk.params.config
 data = {n: xr.load_dataset(getattr(inp, n)) for n in ("construction", "cuts", "ensemble", "tolerance", "exact")}
 r = pp.PileRun(data["construction"], data["cuts"], data["ensemble"], data["exact"], cfg)
 save(pp.figure(r), out, dpi=130, show=True)
+write_finding(out, pp.finding(r))
 
 # %% [markdown]
 # **(a)** The pile at rest with the history forces (line width: normal force), the

@@ -233,3 +233,51 @@ def test_members_do_not_depend_on_the_shard_count(fig3):
             np.testing.assert_array_equal(part[v].values, ref[v].values, err_msg=v)
     warm = fe.run_ensemble(st, cfg, "warm", 0, 1)
     np.testing.assert_array_equal(warm.force_n.values, ens.sel(run=warm.run.values).force_n.values)
+
+
+# ------------------------------------------------------------------ the page (ncd.figures.equilibrium_plots)
+@pytest.fixture(scope="module")
+def page_run(fig3):
+    from ncd.figures import equilibrium_plots as ep
+
+    return ep.Fig3Run(fig3["state"], fig3["ensemble"], fig3["projection"], fig3["uniform"])
+
+
+def test_page_figure_is_legible(page_run):
+    """Panels lettered once each (a, b, then one per contact and exploration), no overlapping
+    texts, fonts of at least 9 pt on a figure of at most 11.5 in."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from ncd.figures import equilibrium_plots as ep
+    from ncd.pages.notebook import MIN_FONT_PT, text_layout
+
+    fig = ep.figure(page_run)
+    letters = [ax.get_title(loc="left").split(")")[0] + ")" for ax in fig.axes if ax.get_title(loc="left")]
+    assert len(letters) == 2 + 4 * len(page_run.shown) == len(set(letters))
+    lay = text_layout(fig)
+    assert lay["overlaps"] == [] and lay["min_font_pt"] >= MIN_FONT_PT and lay["width_in"] <= 11.5
+    plt.close(fig)
+
+
+def test_page_sentences_follow_the_data(page_run, fig3):
+    """The table and sentences of the page carry the measured numbers: converged counts, the
+    coverage of each displayed contact, the face census (every uniform point interior)."""
+    from ncd.figures import equilibrium_plots as ep
+
+    r = page_run
+    conv = ep.convergence_text(r)
+    for m, ds in r.subsets.items():
+        assert f"{m}: {int(ds.converged.sum())} of {ds.sizes['run']} converged" in conv
+    table = ep.measures_table(r)
+    assert table.count("\n") == 1 + len(r.rows)
+    for x in r.rows:
+        assert f"| {x['contact']} | {x['mode']} | {x['points']} | {x['coverage']:.1%} |" in table
+    u = r.faces["uniform"]
+    assert u["interior"] == u["runs"] and f"{u['runs']} points of the uniform sample, {u['runs']} are interior" \
+        in ep.faces_text(r)
+    pa = fig3["projection"].attrs
+    assert f"$\\dim A \\cap C$ = {pa['dimension_AC']}" in ep.packing_text(r)
+    assert "nan" not in (conv + table + ep.findings_text(r) + ep.packing_text(r)).lower()

@@ -268,3 +268,25 @@ def test_demo_page_offline_titled(page):
     html = page.read_text()
     assert external_urls(html) == [] and "import(" not in html
     assert BeautifulSoup(html, "html.parser").title.get_text() == "demo"
+
+
+def test_report_captions_include_the_finding(tmp_path, monkeypatch):
+    """No caption of the Snakemake report holds a ``<placeholder>``; a caption that includes its
+    figure's finding (written by the notebook from the data) renders it, as Snakemake does
+    (docutils, from the working directory)."""
+    from docutils.core import publish_parts
+
+    from tests.conftest import ROOT
+
+    captions = sorted((ROOT / "workflow" / "report").glob("*.rst"))
+    assert captions
+    monkeypatch.chdir(tmp_path)
+    for rst in captions:
+        text = rst.read_text()
+        assert not re.search(r"<[a-z_]+>", text), f"{rst.name}: a placeholder"
+        for inc in re.findall(r"^\.\. include:: (\S+)$", text, flags=re.M):
+            assert inc == f"results/figures/{rst.stem}.finding.rst", inc
+            (tmp_path / inc).parent.mkdir(parents=True, exist_ok=True)
+            (tmp_path / inc).write_text(f"Measured for {rst.stem}: 0.123 N.\n")
+            html = publish_parts(text, writer_name="html")["body"]
+            assert f"Measured for {rst.stem}: 0.123 N." in html

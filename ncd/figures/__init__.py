@@ -9,7 +9,7 @@ modules, so that editing one figure reruns no other.
 FIGURE_MODULES = {
     "fig1_wedged": ("wedged",),
     "fig2_slope": ("census",),
-    "fig3_equilibrium": ("equilibrium", "faces"),
+    "fig3_equilibrium": ("equilibrium", "equilibrium_plots", "faces"),
     "fig4_pile": ("pile", "pile_exact", "pile_plots"),
     "fig4_history": ("history", "history_analysis", "history_exact", "history_plots", "history_size"),
     "fig4_bank": ("bank", "bank_claims", "bank_exact", "bank_plots"),

@@ -187,3 +187,14 @@ def outside_text(an):
             "2 × dip − the percentiles of the resampled dips, which removes their upward bias (a minimum against "
             "maxima of noisy profiles; largest for the narrowest kernel); where the bias exceeds the band's "
             "half-width the band, the bias-corrected statement, lies below the raw dip.")
+
+
+def finding(an):
+    """The figure's finding in a few sentences (the Snakemake report's caption includes it)."""
+    s = summary(an)
+    P, R = s["point"], s["rain"]
+    return (f"Dip depth M − m of the mean ground-stress profile over {s['piles']} piles per history (units of the "
+            f"mean stress W/2L, > 0 a dip, kernel {s['kernel']:g} d): point source {P['dip']:.3f} "
+            f"[{P['lo']:.3f}, {P['hi']:.3f}], rain {R['dip']:.3f} [{R['lo']:.3f}, {R['hi']:.3f}] (95 % bootstrap "
+            f"bands over piles; difference p = {s['p'][s['kernel']]:.2g}). The cut resultant is steeper than the "
+            f"flank at {100 * P['arching']:.0f} % (point source) and {100 * R['arching']:.0f} % (rain) of the cuts.")

@@ -123,40 +123,47 @@ def size_dataset(analyses, seed=16):
 
 
 def figure(sz):
-    """(a) dip of the mean profile, (b) arching deviation, (c) flank slope, against grains per
-    pile, per history with bands over piles; (d) median deviation against cut position per size."""
+    """(a) dip depth of the mean profile, (b) arching deviation, (c) flank slope, against grains
+    per pile, per history with bands over piles; (d) median deviation against cut position per
+    size.  Drawn for the page's width (11 in, fonts of at least 9 pt, legends below the panels)."""
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, 4, figsize=(14, 3.6), constrained_layout=True)
-    n = sz.grains.values
-    k0 = sz.kernel.values[0]
-    for j, h in enumerate(sz.history.values):
-        s = sz.sel(history=h)
-        off = n * (1 + 0.04 * (2 * j - 1))
-        dm, dl, dh = (s[v].sel(kernel=k0).values for v in ("dip_mean", "dip_lo", "dip_hi"))
-        axes[0].errorbar(off, dm, yerr=[dm - dl, dh - dm], fmt="o-", color=COLORS.get(h), capsize=3, label=h)
-        am, al, ah = s.arching_mean.values, s.arching_lo.values, s.arching_hi.values
-        axes[1].errorbar(off, am, yerr=[am - al, ah - am], fmt="o-", color=COLORS.get(h), capsize=3, label=h)
-        axes[2].plot(n, s.surface_angle.values, "o-", color=COLORS.get(h), label=h)
-        for z in sz["size"].values:
-            med = s.deviation_median.sel(size=z).median("flank").values
-            axes[3].plot(sz.cut_position.values, med, "-" if z == sz["size"].values[-1] else "--",
-                         color=COLORS.get(h), alpha=0.5 + 0.5 * z / max(1, sz.sizes["size"] - 1),
-                         label=f"{h}, {int(n[z])} grains")
-    axes[0].axhline(0, color="k", lw=0.5)
-    axes[0].set_ylabel(f"dip of the mean profile (kernel {k0:g} d)")
-    axes[1].axhline(0, color="k", lw=0.5)
-    axes[1].set_ylabel("arching: median cut deviation (°)")
-    axes[2].set_ylabel("flank slope (°)")
-    axes[3].axhline(0, color="k", lw=0.5)
-    axes[3].set_xlabel("cut position |x| / L")
-    axes[3].set_ylabel("median deviation over piles (°)")
-    for ax, t in zip(axes, "abcd"):
-        ax.set_title(f"({t})", loc="left")
-        if t != "d":
+    with plt.rc_context({"font.size": 9.5}):
+        fig, axes = plt.subplots(2, 2, figsize=(11, 7.4), layout="constrained")
+        axes = axes.ravel()
+        n = sz.grains.values
+        k0 = sz.kernel.values[0]
+        for j, h in enumerate(sz.history.values):
+            s = sz.sel(history=h)
+            off = n * (1 + 0.04 * (2 * j - 1))
+            dm, dl, dh = (s[v].sel(kernel=k0).values for v in ("dip_mean", "dip_lo", "dip_hi"))
+            axes[0].errorbar(off, dm, yerr=[dm - dl, dh - dm], fmt="o-", color=COLORS.get(h), capsize=3, label=h)
+            am, al, ah = s.arching_mean.values, s.arching_lo.values, s.arching_hi.values
+            axes[1].errorbar(off, am, yerr=[am - al, ah - am], fmt="o-", color=COLORS.get(h), capsize=3, label=h)
+            axes[2].plot(n, s.surface_angle.values, "o-", color=COLORS.get(h), label=h)
+            for z in sz["size"].values:
+                med = s.deviation_median.sel(size=z).median("flank").values
+                axes[3].plot(sz.cut_position.values, med, "-" if z == sz["size"].values[-1] else "--",
+                             color=COLORS.get(h), alpha=0.5 + 0.5 * z / max(1, sz.sizes["size"] - 1),
+                             label=f"{h}, {int(n[z])} grains")
+        axes[0].axhline(0, color="k", lw=0.5)
+        axes[0].set_ylabel("dip depth M − m (units of W / 2L)")
+        axes[0].set_title(f"(a) dip depth of the mean profile (kernel {k0:g} d; > 0 a dip)", loc="left", fontsize=10)
+        axes[1].axhline(0, color="k", lw=0.5)
+        axes[1].set_ylabel("median cut deviation (°)")
+        axes[1].set_title("(b) arching: resultant − flank slope", loc="left", fontsize=10)
+        axes[2].set_ylabel("flank slope (°)")
+        axes[2].set_title("(c) flank slope", loc="left", fontsize=10)
+        axes[3].axhline(0, color="k", lw=0.5)
+        axes[3].set_xlabel("cut position |x| / L")
+        axes[3].set_ylabel("median deviation over piles (°)")
+        axes[3].set_title("(d) deviation against the cut position", loc="left", fontsize=10)
+        for ax in axes[:3]:
             ax.set_xscale("log")
             ax.set_xlabel("grains per pile")
-        ax.legend(fontsize=7)
+        axes[2].legend(fontsize=9, loc="upper left", bbox_to_anchor=(0, -0.2), ncol=2, frameon=False,
+                       title="(a)–(c), bars: 95 % bootstrap bands over piles", title_fontsize=9)
+        axes[3].legend(fontsize=9, loc="upper left", bbox_to_anchor=(0, -0.2), ncol=2, frameon=False)
     return fig
 
 
@@ -180,3 +187,12 @@ def summary(sz):
 
 
 __all__ = ["size_dataset", "figure", "summary"]
+
+def finding(sz):
+    """The figure's finding in a few sentences (the Snakemake report's caption includes it)."""
+    s = summary(sz)
+    g = s["grains"]
+    return " ".join(
+        f"{h}: from {g[0]} to {g[-1]} grains the dip depth of the mean profile (units of W/2L, > 0 a dip) changes "
+        f"by {s[h]['dip_change']:+.3f} (permutation p = {s[h]['dip_p']:.2f}) and the arching deviation by "
+        f"{s[h]['arching_change']:+.1f}° (p = {s[h]['arching_p']:.2f})." for h in ("point", "rain"))

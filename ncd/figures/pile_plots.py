@@ -305,3 +305,24 @@ def dip_sentence(exact):
             f"analysis choices it spans {a['dip_binning_spread']:.3f}; over A ∩ C it ranges exactly from "
             f"{float(exact.dip_min[m]):+.3f} to {float(exact.dip_max[m]):+.3f}: a dip is **{a['dip_geometry']}** by "
             f"the geometry, and {'a dip is called' if a['dip_called'] else 'no dip is called'}.")
+
+
+def finding(r):
+    """The figure's finding in a few sentences (the Snakemake report's caption includes it)."""
+    P = r.cloud(r.K)
+    lo, hi = min(r.change), max(r.change)
+    if len(P):
+        D = diameter(P)
+        rel = "less than" if D < lo else ("more than" if D > hi else "between")
+        cloud = (f"The {len(P)} zero-guess runs at rest give a cloud of the default cut's resultant {D:.3f} N across "
+                 f"({D / np.linalg.norm(P.mean(0)):.0%} of the resultant), {rel} the changes of {lo:.3f} and "
+                 f"{hi:.3f} N when the cut moves by one diameter.")
+    else:
+        cloud = f"No zero-guess run converged at rest: no cloud; the cut moved by one diameter changes by {lo:.3f} N."
+    ex = r.exact
+    m = list(ex.choice.values).index(ex.attrs["dip_main_choice"])
+    return (cloud + f" Every admissible force state arches across {int(ex.all_arch.sum())} of "
+            f"{ex.sizes['cut']} cuts. The dip depth of the ground pressure under the apex is "
+            f"{float(ex.dip_history[m]):+.3f} W/2L (> 0 a dip) for the history forces, from "
+            f"{float(ex.dip_min[m]):+.3f} to {float(ex.dip_max[m]):+.3f} over A ∩ C: a dip is "
+            f"{ex.attrs['dip_geometry']} by the geometry.")

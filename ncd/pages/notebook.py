@@ -70,8 +70,18 @@ def paths(figure, inputs, smk=None, data_dir=None):
     return SimpleNamespace(
         input=SimpleNamespace(**{n: str(results / (data_dir or figure) / f"{n}.nc") for n in inputs}),
         output=SimpleNamespace(png=str(results / "figures" / f"{figure}.png"),
-                               pdf=str(results / "figures" / f"{figure}.pdf")),
+                               pdf=str(results / "figures" / f"{figure}.pdf"),
+                               finding=str(results / "figures" / f"{figure}.finding.rst")),
         params=SimpleNamespace(config=section), config={figure: section})
+
+
+def write_finding(output, text):
+    """Write the figure's finding (a paragraph computed from the data) to ``output.finding``:
+    the Snakemake report's caption ``workflow/report/<figure>.rst`` includes it."""
+    path = getattr(output, "finding", None)
+    if path is not None:
+        Path(path).parent.mkdir(parents=True, exist_ok=True)
+        Path(path).write_text(" ".join(text.split()) + "\n", encoding="utf-8")
 
 
 def drawn_texts(fig):
@@ -102,9 +112,11 @@ def text_layout(fig, tol_px=1.0):
     """What a reader meets in ``fig``'s texts: ``overlaps`` (pairs of texts whose boxes
     intersect by more than ``tol_px`` pixels each way at the figure's dpi), ``min_font_pt``,
     ``dpi`` and the figure's ``width_in``.  Text over data is not detected."""
+    from matplotlib.text import Text
+
     texts = drawn_texts(fig)
     renderer = fig.canvas.get_renderer()
-    boxes = [t.get_window_extent(renderer) for t in texts]
+    boxes = [Text.get_window_extent(t, renderer) for t in texts]       # an annotation's text, not its arrow
     over = []
     for i in range(len(texts)):
         for j in range(i + 1, len(texts)):

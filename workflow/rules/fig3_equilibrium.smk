@@ -5,16 +5,20 @@
 #   merge       every shard of the three modes            -> ensemble.nc
 #   projection  LP projections of A ∩ C on each contact   -> projection.nc
 #   uniform     hit-and-run sample of A ∩ C               -> uniform.nc
-#   notebook    notebooks/fig3_equilibrium.ipynb           -> results/figures/fig3_equilibrium.png|pdf
+#   notebook    notebooks/fig3_equilibrium.ipynb (figure, table and sentences:
+#               ncd/figures/equilibrium_plots.py)          -> results/figures/fig3_equilibrium.png|pdf
 FIG = "fig3_equilibrium"
 CFG = section(FIG)
 F3 = f"results/{FIG}"
 F3_MODES = ("zero", "random", "warm")
+# the page's figure, table and sentences (equilibrium_plots.py, with faces.py) are read by the notebook only
+F3_PAGE = [str(REL / "ncd" / "figures" / m) for m in ("equilibrium_plots.py", "faces.py")]
+F3_SOURCES = [f for f in ncd_sources(FIG) if f not in F3_PAGE]
 
 
 rule fig3_equilibrium_simulate:
     input:
-        ncd_sources(FIG),
+        F3_SOURCES,
     output:
         f"{F3}/state.nc",
     params:
@@ -31,7 +35,7 @@ rule fig3_equilibrium_simulate:
 
 rule fig3_equilibrium_explore:
     input:
-        ncd_sources(FIG),
+        F3_SOURCES,
         state=f"{F3}/state.nc",
     output:
         temp(f"{F3}/shards/{{name}}_{{shard}}-of-{{n}}.nc"),
@@ -71,7 +75,7 @@ rule fig3_equilibrium_merge:
 
 rule fig3_equilibrium_projection:
     input:
-        ncd_sources(FIG),
+        F3_SOURCES,
         state=f"{F3}/state.nc",
     output:
         f"{F3}/projection.nc",
@@ -89,7 +93,7 @@ rule fig3_equilibrium_projection:
 
 rule fig3_equilibrium_uniform:
     input:
-        ncd_sources(FIG),
+        F3_SOURCES,
         state=f"{F3}/state.nc",
     output:
         f"{F3}/uniform.nc",
@@ -111,12 +115,14 @@ rule fig3_equilibrium_notebook:
         ensemble=f"{F3}/ensemble.nc",
         projection=f"{F3}/projection.nc",
         uniform=f"{F3}/uniform.nc",
+        plots=F3_PAGE,
         notebook=notebook_file(FIG),
         notebook_py=notebook_file(FIG, "py"),
         pages=page_sources("notebook"),
     output:
         png=figure_output(FIG, "png"),
         pdf=figure_output(FIG, "pdf"),
+        finding=f"results/figures/{FIG}.finding.rst",   # included by the report's caption
     params:
         config=without_shards(CFG),
     log:

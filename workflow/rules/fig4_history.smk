@@ -153,6 +153,7 @@ rule fig4_history_notebook:
     output:
         png=figure_output(FIGH, "png"),
         pdf=figure_output(FIGH, "pdf"),
+        finding=f"results/figures/{FIGH}.finding.rst",   # included by the report's caption
     params:
         config=CFGH,
     log:
@@ -202,6 +203,7 @@ rule fig4_history_size_notebook:
     output:
         png=figure_output(FHS, "png"),
         pdf=figure_output(FHS, "pdf"),
+        finding=f"results/figures/{FHS}.finding.rst",   # included by the report's caption
     params:
         config={k: v for k, v in CFGH.items() if k == "size"},
     log:

@@ -135,6 +135,7 @@ rule fig4_pile_notebook:
     output:
         png=figure_output(FIG4, "png"),
         pdf=figure_output(FIG4, "pdf"),
+        finding=f"results/figures/{FIG4}.finding.rst",   # included by the report's caption
     params:
         config=without_shards(CFG4),
     log:
