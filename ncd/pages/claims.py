@@ -25,8 +25,10 @@ import yaml
 from ncd.core.scene import make_scene
 from ncd.core.verdict import BEYOND, DIFFERS, NOT_COMPUTED, NOT_TESTED, REPRODUCED, Verdict
 from ncd.dynamics.stepper import prepare_step, step
+from ncd.figures import bank_claims as bank
 from ncd.figures import equilibrium as fe
 from ncd.figures import faces
+from ncd.figures import governing_claims as unger
 from ncd.figures.governing_summary import factor_table, line_counts
 from ncd.solver.convergence import REST
 
@@ -669,19 +671,21 @@ MEASURES = {
     "s5-cut-position": [("fig4_pile", fig4_cut_vs_cloud)],
     "s5-ten-contacts": [("fig4_pile", fig4_contacts)],
     "s6-reassuring": [("fig4_pile", fig4_reassuring)],
+    "s5-surface-parallel-vertical": [("fig4_bank", bank.claim_surface_force_vertical)],
+    "s5-incipient-failure": [("fig4_bank", bank.claim_incipient_failure)],
+    "s5-reciprocity": [("fig4_bank", bank.claim_reciprocity)],
+    # Unger, Kertész & Wolf's findings, judged on their terms (their statistic and packings)
+    "s4-unger": [("fig5_governing", unger.claim_unger_peak), ("fig5_governing", unger.claim_unger_vanishes),
+                 ("fig5_governing", unger.claim_unger_control), ("fig5_governing", unger.claim_unger_centrality)],
 }
 
 UNTESTED_REASONS = {
     "s2-md-forces-state": "the MD baseline (ncd/dynamics/md.py) is used for stability only; no exploration of "
                           "the plurality of its force states is run",
-    "s4-unger": "a reference, not a claim; Unger et al.'s statistic is measured on the governing-parameters page",
     "s5-warm-construction": "the final step of a warm-started construction is not explored with random orders "
                             "from the warm guess (the zero-guess cloud is)",
-    "s5-surface-parallel-vertical": "cuts parallel to the free surface are not measured yet",
-    "s5-incipient-failure": "the mobilized friction on surface-parallel planes is not measured yet",
     "s5-cylindric-cuts": "a 3-D statement (cylindric cuts of a conical pile); the 2-D analogue is the vertical "
-                         "cut of §5",
-    "s5-reciprocity": "the granular stress tensor and the reciprocity formula are not measured yet",
+                         "cut of §5, and the end of the fig4_bank page says what a plane pile can say of it",
     "s6-incremental-coulomb": "a statement about theory (an incremental Coulomb law), not about a computation",
 }
 
@@ -717,5 +721,7 @@ def claim_markdown(claim_id, results, figure=None):
     quote, the measured value and the verdict with its criterion (the index's own words)."""
     claim = CLAIM_BY_ID[claim_id]
     rows = [(f, v) for f, v in verdicts(claim_id, results) if figure is None or f == figure]
-    body = "\n".join(f"**{v.verdict}** — {v.value}. *Criterion:* {v.criterion}." for _, v in rows)
+    own = anchor(claim_id)
+    body = "\n\n".join((f'<a id="{v.anchor}"></a>' if v.anchor and v.anchor != own else "")
+                       + f"**{v.verdict}** — {v.value}. *Criterion:* {v.criterion}." for _, v in rows)
     return (f'<a id="{anchor(claim_id)}"></a>\n\n> {claim["section"]}: “{claim["quote"]}”\n\n{body}\n')
