@@ -250,11 +250,19 @@ def test_data_exact_ranges_contain_the_history(data):
 
 
 def test_claims_and_page(results):
-    for f in (bank_claims.claim_surface_force_vertical, bank_claims.claim_reciprocity,
-              bank_claims.claim_incipient_failure):
+    """Each claim is printed on the page under the anchor of its section and the paper-claim anchor
+    of the index, with its verdict and value."""
+    import html as html_lib
+    import re
+
+    html = (results / "html" / "fig4_bank.html").read_text(encoding="utf-8")
+    for claim_id, f in bank_claims.PAPER_CLAIMS.items():
         v = f(results)
         assert v.verdict in VERDICTS and v.verdict != "not computed"
         assert v.value and v.criterion and all((results / p).exists() for p in v.data)
-        html = (results / "html" / "fig4_bank.html").read_text()
         assert f'id="{v.anchor}"' in html
+        at = html.find(f'id="claim-{claim_id}"')
+        assert at > 0, claim_id
+        block = html_lib.unescape(re.sub(r"<[^>]+>", "", html[at:at + 20000]))
+        assert v.verdict in block and v.value[:60] in block, claim_id
     assert bank_claims.claim_reciprocity(results).verdict == "reproduced"

@@ -345,3 +345,9 @@ def three_d_text(ms):
         "the share of the available friction the bank mobilizes, the principal directions) are those of 2-D disc "
         "piles; only the identities (reciprocity, the weight of a column, the symmetry at equilibrium) carry over "
         "to Moreau's conic and cylindric cuts unchanged.")
+
+
+# the sentences of the paper's claims table (ncd/pages/paper_claims.yaml) these functions judge
+PAPER_CLAIMS = {"s5-surface-parallel-vertical": claim_surface_force_vertical,
+                "s5-reciprocity": claim_reciprocity,
+                "s5-incipient-failure": claim_incipient_failure}
