@@ -72,6 +72,7 @@ from IPython.display import Markdown, display
 
 from ncd.figures import bank_claims as bc
 from ncd.figures import bank_plots as bp
+from ncd.pages.claims import anchor
 from ncd.pages.notebook import paths, save
 
 # Snakemake's object, or by hand (from the repository or notebooks/) the files under results/
@@ -82,6 +83,11 @@ ms = xr.load_dataset(inp.measures)
 exact = {Path(p).stem: xr.load_dataset(p) for p in getattr(inp, "exact", None) or
          sorted(glob(str(results / "fig4_bank" / "exact" / "*.nc")))}
 con = xr.load_dataset(getattr(inp, "construction", results / "fig4_pile" / "construction.nc"))
+
+
+def claim(claim_id):
+    """The verdict of a claim of the paper, the same object the index prints, under the anchor it links to."""
+    return Markdown(f'<a id="{anchor(claim_id)}"></a>\n\n' + bc.verdict_markdown(bc.PAPER_CLAIMS[claim_id](results)))
 
 # %%
 fig = bp.figure(ms, exact, con)
@@ -95,7 +101,7 @@ display(Markdown(bp.caption(ms)))
 
 # %%
 tol = float(ms.attrs["vertical_tol_deg"])
-display(Markdown(bc.verdict_markdown(bc.claim_surface_force_vertical(results))))
+display(claim("s5-surface-parallel-vertical"))
 display(Markdown(bc.cuts_text(ms)))
 
 # %% [markdown]
@@ -118,14 +124,14 @@ display(Markdown(bc.stress_text(ms, exact)))
 # ## <a id="reciprocity"></a>The reciprocity formula
 
 # %%
-display(Markdown(bc.verdict_markdown(bc.claim_reciprocity(results))))
+display(claim("s5-reciprocity"))
 display(Markdown(bc.reciprocity_text(ms)))
 
 # %% [markdown]
 # ## <a id="incipient-failure"></a>Incipient failure as a stress state
 
 # %%
-display(Markdown(bc.verdict_markdown(bc.claim_incipient_failure(results))))
+display(claim("s5-incipient-failure"))
 display(Markdown(bc.failure_text(ms)))
 
 # %% [markdown]

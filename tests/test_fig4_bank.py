@@ -179,6 +179,22 @@ def test_plane_stress_of_an_infinite_slope_and_principal_directions():
     assert (s1[0], s2[0], beta[0], sin_phi[0]) == pytest.approx((3.0, 1.0, 30.0, 0.5))
 
 
+def test_slope_at_the_limit_leans_its_major_direction_by_45_minus_half_theta():
+    """A vertical force on the surface-parallel planes fixes sigma up to k t (x) t; the Mohr circle
+    touching tan(theta) there (the least mobilized friction, sin phi = sin theta) puts the major
+    direction 45 - theta/2 degrees from the vertical, leaning towards the axis: the principal
+    directions of a bank at incipient failure, against which the page reads its own."""
+    from scipy.optimize import minimize_scalar
+    for theta in (16.0, 25.0):
+        t, n = st.flank_frame(theta, 1)
+        base = np.cos(np.radians(theta)) * (np.outer([0, 1], n) + np.outer(n, [0, 1]) - n[1] * np.outer(n, n))
+        sin_phi = lambda k: st.principal((base + k * np.outer(t, t))[None])[3][0]  # noqa: E731
+        k = minimize_scalar(sin_phi, bounds=(-0.5, 5.0), method="bounded", options={"xatol": 1e-12}).x
+        assert np.degrees(np.arcsin(sin_phi(k))) == pytest.approx(theta, abs=1e-6)
+        beta = st.principal((base + k * np.outer(t, t))[None])[2][0]
+        assert beta == pytest.approx(-(45.0 - theta / 2), abs=1e-4)
+
+
 def test_config_section_is_checked(tmp_path):
     from pathlib import Path
     root = Path(__file__).resolve().parent.parent
@@ -250,11 +266,19 @@ def test_data_exact_ranges_contain_the_history(data):
 
 
 def test_claims_and_page(results):
-    for f in (bank_claims.claim_surface_force_vertical, bank_claims.claim_reciprocity,
-              bank_claims.claim_incipient_failure):
+    """Each claim is printed on the page under the anchor of its section and the paper-claim anchor
+    of the index, with its verdict and value."""
+    import html as html_lib
+    import re
+
+    html = (results / "html" / "fig4_bank.html").read_text(encoding="utf-8")
+    for claim_id, f in bank_claims.PAPER_CLAIMS.items():
         v = f(results)
         assert v.verdict in VERDICTS and v.verdict != "not computed"
         assert v.value and v.criterion and all((results / p).exists() for p in v.data)
-        html = (results / "html" / "fig4_bank.html").read_text()
         assert f'id="{v.anchor}"' in html
+        at = html.find(f'id="claim-{claim_id}"')
+        assert at > 0, claim_id
+        block = html_lib.unescape(re.sub(r"<[^>]+>", "", html[at:at + 20000]))
+        assert v.verdict in block and v.value[:60] in block, claim_id
     assert bank_claims.claim_reciprocity(results).verdict == "reproduced"

@@ -273,8 +273,7 @@ def stress_text(ms, exact):
     r = reciprocity_numbers(ms, exact)
     s = stress_numbers(ms)
     return (f"Asymmetry: over the {r['windows']} windows of {r['piles']} piles, |σ_xy − σ_yx| is at most "
-            f"{r['asym_max']:.1e} of the mean pressure p (history forces, equilibrium solved to a residual of about "
-            f"1e-10)" + (f", and at most {r['vertex_asymmetry']:.0e} p at the LP points of A ∩ C that realise the "
+            f"{r['asym_max']:.1e} of the mean pressure p (history forces)" + (f", and at most {r['vertex_asymmetry']:.0e} p at the LP points of A ∩ C that realise the "
                          f"extreme angles" if np.isfinite(r['vertex_asymmetry']) else "")
             + f". A window holds {s['grains']:.0f} grains on median. "
             f"Traction against the cuts: the force per unit length −σn_s of the window differs from the "
@@ -306,23 +305,27 @@ def reciprocity_text(ms):
 
 
 def failure_text(ms):
+    """tau / sigma_n against tan(flank) and tan(phi) of the most loaded plane, and the principal
+    directions against those of a slope at the limit (Mohr circle touching tan(theta) on the
+    surface-parallel planes: the major direction leans towards the axis by 45° - theta/2)."""
     f = failure_numbers(ms)
     s = ms.sel(history=CLAIM_HISTORY)
     pos = [(float(q), float(s.major_by_position[j])) for j, q in enumerate(ms.position.values)
            if np.isfinite(s.major_by_position[j])]
+    theta = float(np.degrees(np.arctan(f["tan_flank"])))
+    close = f["share"] >= 0.9
     return (f"On the point-source piles τ/σ_n on the surface-parallel planes is {f['mobilized']:.3f} on median "
             f"against tan θ = {f['tan_flank']:.3f} of the fitted flanks: the ratio is {f['ratio']:.2f} "
             f"({f['lo']:.2f} to {f['hi']:.2f}). It equals tan θ exactly when the force across the plane is vertical "
             f"(a slab carrying its weight): the same statement as the first claim, read as a stress state. The most "
             f"loaded plane of the same windows mobilizes tan φ = {f['tan_phi']:.3f} on median, so the "
-            f"surface-parallel plane carries {f['share']:.2f} of it: it is close to the most loaded plane, as in a "
-            f"bank at incipient failure, whose failure planes are parallel to the surface. The packing's "
-            f"macroscopic friction is not measured here (no shear test); the angle of repose θ stands for it, as "
-            f"in the Civil-Engineering reading. Major principal direction from the vertical along the flank "
-            f"(leaning outward positive), medians by position |x|/L: {_fmt_list(pos)}"
-            + (f": the major compression leans towards the axis, along lines descending outward at "
-               f"{90 - max(abs(m) for _, m in pos):.0f}° to {90 - min(abs(m) for _, m in pos):.0f}° from the "
-               f"horizontal, steeper than the flank." if pos and all(m < 0 for _, m in pos) else "."))
+            f"surface-parallel plane carries {f['share']:.2f} of it: "
+            + ("it is close to the most loaded plane, as in a bank at incipient failure, whose failure planes are "
+               "parallel to the surface. " if close else "it is not the most loaded plane. ")
+            + "The packing's macroscopic friction is not measured here (no shear test); the angle of repose θ stands "
+            f"for it, as in the Civil-Engineering reading. In a slope at that limit the major principal direction "
+            f"leans towards the axis by 45° − θ/2 = {45 - theta / 2:.1f}° from the vertical; measured (leaning "
+            f"outward positive), medians over the piles by position |x|/L: {_fmt_list(pos)}.")
 
 
 def three_d_text(ms):
@@ -340,8 +343,14 @@ def three_d_text(ms):
         "**Cannot.** A 2-D pile of discs is a plane wedge: it has no hoop stress σ_θθ, which in an axisymmetric "
         "3-D pile enters the radial balance and changes how the weight is shared between the core and the bank; "
         "a cylindric cut near the axis encloses less material than a vertical cut through a wedge. The flanks of "
-        f"these disc piles slope at {theta:.1f}° on median, less than the angle of repose of 3-D grains, and the "
-        "contact network of discs differs from that of spheres. The numbers of this page (the spread of the angles, "
+        f"these disc piles slope at {theta:.1f}° on median; the angle of repose and the contact network of discs "
+        "differ from those of spheres. The numbers of this page (the spread of the angles, "
         "the share of the available friction the bank mobilizes, the principal directions) are those of 2-D disc "
         "piles; only the identities (reciprocity, the weight of a column, the symmetry at equilibrium) carry over "
         "to Moreau's conic and cylindric cuts unchanged.")
+
+
+# the sentences of the paper's claims table (ncd/pages/paper_claims.yaml) these functions judge
+PAPER_CLAIMS = {"s5-surface-parallel-vertical": claim_surface_force_vertical,
+                "s5-reciprocity": claim_reciprocity,
+                "s5-incipient-failure": claim_incipient_failure}

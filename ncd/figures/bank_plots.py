@@ -154,8 +154,14 @@ def plot_failure(ax, ms):
 
 
 def plot_principal(ax, ms):
-    """(g) The major principal direction from the vertical along the flank (medians and bands)."""
+    """(g) The major principal direction from the vertical along the flank (medians and bands), and
+    that of a slope at the limit, -(45° - theta/2), theta the point-source piles' median flank angle."""
     ax.axhline(0.0, color="0.5", lw=0.6)
+    if "point" in _histories(ms):
+        theta = float(np.degrees(np.arctan(np.nanmedian(ms.tan_flank.values[ms.pile_history.values == "point"]))))
+        ax.axhline(-(45.0 - theta / 2), color=COLORS["point"], lw=0.8, ls="--")
+        ax.set_title(f"dashed: a slope at the limit, θ = {theta:.1f}°", fontsize=FONT - 1, loc="right",
+                     color=COLORS["point"])
     _medians(ax, ms, "major", "position", "cut centre |x| / L", "major principal direction\nfrom the vertical "
              "(deg, + outward)")
 
@@ -180,7 +186,8 @@ def figure(ms, exact, con):
     fig.legend(handles, labels, loc="upper left", bbox_to_anchor=(0.69, 0.8), fontsize=FONT, frameon=False,
                title="medians over cuts and piles,\nbars: bootstrap band over piles", title_fontsize=FONT)
     h5, l5 = axes[4].get_legend_handles_labels()
-    axes[4].legend(h5[::-1], l5[::-1], fontsize=FONT - 1, loc="upper left", frameon=False, markerscale=3)
+    axes[4].legend(h5[::-1], l5[::-1], fontsize=FONT - 1, loc="upper left", framealpha=0.9, edgecolor="none",
+                   markerscale=3)
     for ax, letter in zip(axes, "abcdefg"):
         ax.tick_params(labelsize=FONT - 1)
         ax.text(-0.02, 1.03, f"({letter})", transform=ax.transAxes, fontsize=FONT + 1, fontweight="bold",
@@ -203,4 +210,4 @@ def caption(ms, depth_index=1):
             f"the mean pressure p: from the window's stress (coloured, on the diagonal) and from the cuts' own sums "
             f"(grey). **(f)** τ/σ_n on the surface-parallel plane against tan θ of the flank, per window (diamonds: "
             f"medians); the diagonal is a vertical force. **(g)** Major principal direction from the vertical along "
-            f"the flank.")
+            f"the flank; dashed: a slope at the limit of friction tan θ on its surface-parallel planes.")

@@ -56,7 +56,7 @@ rule fig4_bank_exact:
     input:
         BANK_SOURCES,
         pile=lambda w: bank_pile(w.pile),
-        cuts=lambda w: ["results/fig4_pile/cuts.nc"] if w.pile == "default" else [],   # the default pile's fits
+        cuts=lambda w: "results/fig4_pile/cuts.nc" if w.pile == "default" else [],   # the default pile's fits
     output:
         f"{BANK_DIR}/exact/{{pile}}.nc",
     wildcard_constraints:
