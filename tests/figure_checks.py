@@ -63,9 +63,47 @@ def problems(fig, min_pt=9.0, max_width_in=10.5, pad=0.5):
                 continue       # the same text drawn twice (e.g. a tick label of a shared axis)
             if (min(ba.x1, bb.x1) - max(ba.x0, bb.x0) > pad and min(ba.y1, bb.y1) - max(ba.y0, bb.y0) > pad):
                 found.append(f"overlap: {a.get_text()[:30]!r} and {b.get_text()[:30]!r}")
+    found += legends_over_data(fig)
     titles = [ax.get_title(loc) for ax in fig.axes if ax.get_visible() for loc in ("left", "center")]
     letters = [m.group(1) for t in titles for m in [LETTER.match(t)] if m]
     dup = sorted({x for x in letters if letters.count(x) > 1})
     if dup:
         found.append(f"panel letters repeated: {dup}")
     return found
+
+
+def _display_points(artist):
+    """Points of a line (densified along its segments) or of a scatter, in display pixels."""
+    if hasattr(artist, "get_xydata"):
+        xy = artist.get_transform().transform(np.asarray(artist.get_xydata(), float))
+        xy = xy[np.isfinite(xy).all(1)]
+        if len(xy) < 2:
+            return xy
+        steps = np.linspace(0, 1, 25)[:, None, None]
+        return (xy[:-1] + steps * (xy[1:] - xy[:-1])).reshape(-1, 2)
+    offsets = np.asarray(artist.get_offsets(), float)
+    return artist.get_offset_transform().transform(offsets) if len(offsets) else offsets
+
+
+def legends_over_data(fig):
+    """Legends drawn inside an axes over some of its lines or markers."""
+    renderer = fig.canvas.get_renderer()
+    out = []
+    for ax in fig.axes:
+        leg = ax.get_legend()
+        if leg is None or not ax.get_visible():
+            continue
+        bb = leg.get_window_extent(renderer)
+        for artist in list(ax.get_lines()) + list(ax.collections):
+            if not artist.get_visible() or (hasattr(artist, "get_offsets") and not hasattr(artist, "get_xydata")
+                                            and len(artist.get_offsets()) == 0):
+                continue
+            try:
+                pts = _display_points(artist)
+            except (AttributeError, ValueError):
+                continue
+            inside = ((pts[:, 0] > bb.x0) & (pts[:, 0] < bb.x1) & (pts[:, 1] > bb.y0) & (pts[:, 1] < bb.y1))
+            if inside.any():
+                out.append(f"legend over data in {ax.get_title()[:30]!r}")
+                break
+    return out

@@ -7,7 +7,7 @@ the same table: a figure's computing rules depend on the layers below and on its
 modules, so that editing one figure reruns no other.
 """
 FIGURE_MODULES = {
-    "fig1_wedged": ("wedged",),
+    "fig1_wedged": ("wedged", "wedged_page"),
     "fig2_slope": ("census",),
     "fig3_equilibrium": ("equilibrium", "faces"),
     "fig4_pile": ("pile", "pile_exact"),

@@ -86,6 +86,7 @@ rule fig1_wedged_notebook:
         ensemble="results/fig1_wedged/ensemble.nc",
         evolutions="results/fig1_wedged/evolutions.nc",
         sweep="results/fig1_wedged/sweep.nc",
+        page=page_modules(FIG),
         notebook=notebook_file("fig1_wedged"),
         notebook_py=notebook_file("fig1_wedged", "py"),
         pages=page_sources("notebook"),
