@@ -282,6 +282,7 @@ def test_page_sentences_count_the_runs(data):
 
 def test_page_figure_is_readable(data):
     from figure_checks import problems
+
     from ncd.figures import wedged_page as page
 
     assert problems(page.plot(data["ens"], data["evo"], data["sweep"], data["wedge"])) == []
