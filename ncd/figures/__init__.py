@@ -8,7 +8,7 @@ modules, so that editing one figure reruns no other.
 """
 FIGURE_MODULES = {
     "fig1_wedged": ("wedged", "wedged_page"),
-    "fig2_slope": ("census",),
+    "fig2_slope": ("census", "slope_page"),
     "fig3_equilibrium": ("equilibrium", "faces"),
     "fig4_pile": ("pile", "pile_exact"),
     "fig4_history": ("history", "history_analysis", "history_exact", "history_plots", "history_size"),

@@ -118,6 +118,7 @@ rule fig2_slope_notebook:
         ensemble=f"{F2}/ensemble.nc",
         measures=f"{F2}/measures.nc",
         census=f"{F2}/census.nc",
+        page=page_modules(FIG2),
         notebook=notebook_file(FIG2),
         notebook_py=notebook_file(FIG2, "py"),
         pages=page_sources("notebook"),
