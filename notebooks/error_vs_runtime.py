@@ -42,6 +42,8 @@
 # reference's own uncertainty).
 
 # %%
+from pathlib import Path
+
 import matplotlib
 import xarray as xr
 from IPython.display import HTML, Markdown, display
@@ -59,6 +61,7 @@ results = results_dir(snakemake)
 
 # %%
 save(page.plot(nl, df), snakemake.output, dpi=100, show=True)
+Path(snakemake.output.png).with_suffix(".caption.rst").write_text(page.caption(nl, df))
 
 # %% [markdown]
 # (a–c) Distance of the end-of-step velocities to the limit against wall time, one point

@@ -34,6 +34,8 @@
 # step; (iii) the same random exploration over a range of friction angles.
 
 # %%
+from pathlib import Path
+
 import matplotlib
 import xarray as xr
 import yaml
@@ -56,6 +58,7 @@ results = results_dir(snakemake)
 
 # %%
 save(page.plot(ens, evo, swp, wedge), snakemake.output, dpi=100, show=True)
+Path(snakemake.output.png).with_suffix(".caption.rst").write_text(page.caption(ens, swp, wedge))
 
 # %% [markdown]
 # (a) $B$ between the two fixed discs, the Coulomb cones (orange), the lines of action of

@@ -40,6 +40,8 @@
 # an iteration error shrinks with the tolerance.
 
 # %%
+from pathlib import Path
+
 import matplotlib
 import xarray as xr
 from IPython.display import HTML, Markdown, display
@@ -60,6 +62,7 @@ results = results_dir(_smk)
 
 # %%
 save(page.plot(traj, ens, meas, cfg), _smk.output, dpi=100, show=True)
+Path(_smk.output.png).with_suffix(".caption.rst").write_text(page.caption(ens, meas))
 
 # %% [markdown]
 # (a) The flow at the investigated step, each grain coloured by its zero-guess spread at the

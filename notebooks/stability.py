@@ -37,6 +37,8 @@
 # neighbour, tunnels through a disc or stops NLGS at its sweep budget on some step.
 
 # %%
+from pathlib import Path
+
 import matplotlib
 import xarray as xr
 from IPython.display import HTML, Markdown, display
@@ -55,6 +57,7 @@ results = results_dir(snakemake)
 # %%
 fig = page.plot(tab)
 save(fig, snakemake.output, dpi=100, show=True)
+Path(snakemake.output.png).with_suffix(".caption.rst").write_text(page.caption(tab))
 
 # %% [markdown]
 # (a) Every run: a circle per CD run above its case, a square per MD run below, coloured by

@@ -295,3 +295,16 @@ def test_page_sweep_sentence_matches_the_closed_form_threshold(data):
     text = page.sweep_sentence(swp, w, data["cfg"]["ensemble"]["force_max"])
     assert "the wedged fraction is 0 at most below" in text
     assert f"{swp.sizes['gamma']} friction angles" in text
+
+
+def test_report_caption_counts_the_runs(data):
+    from docutils.core import publish_parts
+
+    from ncd.figures import wedged_page as page
+
+    ens, w = data["ens"], data["wedge"]
+    text = page.caption(ens, data["sweep"], w)
+    zero = ens.zero_guess.values == 1
+    assert f"of {int(zero.sum())} zero-guess runs let the disc fall" in text
+    assert f"{int((ens.outcome.values == 1).sum())} of {int((~zero).sum())} random-guess runs keep it wedged" in text
+    publish_parts(text, writer_name="html", settings_overrides={"report_level": 2, "halt_level": 2})

@@ -237,6 +237,8 @@ def test_the_page_sentences_quote_the_files(data):
         several = int((traj.scan_zero_solutions.values > 1).sum())
         assert f"at {several} steps from the zero guess" in page.scan_sentence(traj, cfg)
     assert problems(page.plot(traj, ens, meas, cfg)) == []
+    cap = page.caption(ens, meas)
+    assert f"reach {int(meas.attrs['n_solutions'])} distinct solution(s)" in cap and meas.attrs["verdict"] in cap
 
 
 def _ratio(x, y, weights=None):

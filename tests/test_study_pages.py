@@ -199,3 +199,17 @@ def test_work_precision_page_on_the_run(results):
     r = WP.sweep_ratios(nl)
     for st in nl.state.values:                      # the sentence quotes the extremes of the ratio
         assert f"{float(r.sel(state=st).max()):.2g} times fewer" in WP.nlgs_sentences(nl)
+
+
+def test_captions_state_the_finding():
+    """The report captions are sentences from the data (valid reStructuredText, no placeholder)."""
+    from docutils.core import publish_parts
+
+    from ncd.studies import work_precision_page as WP
+
+    for text in (SP.caption(small_table()), WP.caption(small_nlgs(), small_integration())):
+        assert "<" not in text and "TODO" not in text
+        publish_parts(text, writer_name="html", settings_overrides={"report_level": 2, "halt_level": 2})
+    assert "bounded in 4 of 4 runs" in SP.caption(small_table()) and "3 of its stable runs are inaccurate" in \
+        SP.caption(small_table())
+    assert "rest 4 to 4; flow 0.5 to 0.5" in WP.caption(small_nlgs(), small_integration())

@@ -321,3 +321,17 @@ def plot(traj, ens, meas, cfg):
                Line2D([], [], ls="", marker="o", color="0.1", label=f"(b, c) dark: tol {tight:.0e}")]
     fig.legend(handles=handles, loc="outside lower center", ncol=4, fontsize=9, frameon=False)
     return fig
+
+
+def caption(ens, meas):
+    """The Snakemake report's caption (reStructuredText): the figure's finding, from the data."""
+    grain = int(meas.attrs["grain"])
+    tols = np.sort(ens.tol.values)
+    tight, loose = tols[0], tols[-1]
+    sp = meas.spread.sel(disc=grain)
+    return (f"**Figure 2 (section 3): dispersion of a grain's acceleration in a flow down a slope.** At the "
+            f"investigated step the runs (both guesses) reach {int(meas.attrs['n_solutions'])} distinct solution(s); the "
+            f"RMS spread of grain {grain}'s acceleration is {float(sp.sel(init='zero', tol=loose)):.2g} m/s2 at "
+            f"tolerance {loose:.0e} and {float(sp.sel(init='zero', tol=tight)):.2g} m/s2 at {tight:.0e} from the "
+            f"zero guess, {float(sp.sel(init='warm', tol=tight)):.2g} m/s2 from the warm start: "
+            f"{meas.attrs['verdict']}. Details: ``results/html/fig2_slope.html``.\n")

@@ -221,3 +221,20 @@ def plot(ens, evo, swp, wedge):
     ax_f.set_ylabel("fraction of wedged runs")
     ax_f.set_title(f"(f) threshold sweep:\n{swp.sizes['run']} random guesses per angle", fontsize=10)
     return fig
+
+
+def caption(ens, swp, wedge):
+    """The Snakemake report's caption (reStructuredText): the figure's finding, from the data."""
+    conv, zero, out = ens.converged.values == 1, ens.zero_guess.values == 1, ens.outcome.values
+    wed, n, _, _, iy = wedged_runs(ens)
+    y_bot, y_top = wedge.segment
+    frac, gam = swp.wedged_fraction.values, swp.gamma.values
+    beta = np.degrees(wedge.beta)
+    below = np.nanmax(frac[gam < beta]) if (gam < beta).any() else 0.0
+    on_segment = (f"every one with its point I within {np.abs(iy - wedge.y_of_n(n)).max() / wedge.radius:.0e} R of "
+                  f"the closed-form segment, spanning {100 * (iy.max() - iy.min()) / (y_top - y_bot):.0f} % of it"
+                  if wed.any() else "none to compare with the closed-form segment")
+    return (f"**Figure 1 (section 1): the wedged disc.** One step from rest: {int((out[conv & zero] == FALLS).sum())} "
+            f"of {int(zero.sum())} zero-guess runs let the disc fall, while {int(wed.sum())} of {int((~zero).sum())} "
+            f"random-guess runs keep it wedged, {on_segment}. The largest wedged fraction below the closed-form "
+            f"threshold (friction angle = {beta:.0f} degrees) is {below:.2g}. Details: ``results/html/fig1_wedged.html``.\n")

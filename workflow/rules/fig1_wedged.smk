@@ -93,6 +93,7 @@ rule fig1_wedged_notebook:
     output:
         png=figure_output("fig1_wedged", "png"),
         pdf=figure_output("fig1_wedged", "pdf"),
+        caption=caption_output("fig1_wedged"),
     log:
         notebook="results/notebooks/fig1_wedged.ipynb",
     benchmark:

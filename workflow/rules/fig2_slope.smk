@@ -125,6 +125,7 @@ rule fig2_slope_notebook:
     output:
         png=figure_output(FIG2, "png"),
         pdf=figure_output(FIG2, "pdf"),
+        caption=caption_output(FIG2),
     params:
         config=without_shards(CFG2),
     log:
