@@ -90,3 +90,18 @@ def test_hand_typed_number_is_noticed():
     text = ("# %% [markdown]\n# intro 60 %\n\n# %%\nx = 1\n\n# %% [markdown]\n"
             "# The clouds cover about 60 % and 95 %; $h = 0.3$ ms is `tol: 1.5`.\n")
     assert typed_numbers(jupytext.reads(text, fmt="py:percent")) == ["60 %", "95 %"]
+
+
+# pages rewritten as paper sections: analysis and plots in the package, a few lines per cell
+SECTION_PAGES = ("fig1_wedged", "fig2_slope", "stability", "error_vs_runtime")
+
+
+@pytest.mark.parametrize("name", SECTION_PAGES)
+def test_page_notebook_is_short_and_prints_no_log(name):
+    nb = jupytext.read(Path(__file__).resolve().parent.parent / "notebooks" / f"{name}.py")
+    code = [c.source for c in nb.cells if c.cell_type == "code"]
+    lines = [ln for src in code for ln in src.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
+    assert len(lines) <= 120, f"{name}: {len(lines)} lines of code"
+    body = [[ln for ln in src.splitlines() if ln.strip() and not ln.startswith(("import ", "from "))] for src in code]
+    assert max(map(len, body)) <= 12, "a cell of more than 12 lines besides its imports"
+    assert not any("print(" in src for src in code), f"{name} prints a log"
