@@ -308,3 +308,16 @@ def test_report_caption_counts_the_runs(data):
     assert f"of {int(zero.sum())} zero-guess runs let the disc fall" in text
     assert f"{int((ens.outcome.values == 1).sum())} of {int((~zero).sum())} random-guess runs keep it wedged" in text
     publish_parts(text, writer_name="html", settings_overrides={"report_level": 2, "halt_level": 2})
+
+
+def test_labels_say_what_the_variables_hold(data):
+    """``wedged_fraction`` counts converged runs only (its label says so); the evolutions'
+    ``angle`` is B's rotation in radians (it was labelled degrees): B, symmetric between the
+    two obstacles, does not turn."""
+    swp, evo = data["sweep"], data["evo"]
+    conv = swp.converged == 1
+    expect = ((swp.outcome == 1) & conv).sum("run") / conv.sum("run")
+    np.testing.assert_allclose(swp.wedged_fraction.values, expect.values, equal_nan=True)
+    assert "converged" in swp.wedged_fraction.attrs["long_name"]
+    assert evo.angle.attrs["units"] == "rad" and "rotation" in evo.angle.attrs["long_name"]
+    assert float(np.abs(evo.angle).max()) < 1e-9

@@ -399,3 +399,26 @@ def test_census_solutions_are_exact_and_contain_the_nlgs_end_points(data, result
             d = max(np.abs(cen.accel_x.values[i] - cen.accel_x.values[j]).max(),
                     np.abs(cen.accel_y.values[i] - cen.accel_y.values[j]).max())
             assert d > ccfg["same_tol"] * step.g
+
+
+def test_angles_say_what_they_hold(data):
+    """``trajectory.angle`` is the discs' rotation in radians (it was labelled degrees): at the
+    investigated step it differs from the stored frame of that step by at most one step of spin.
+    ``measures.angle`` is the direction of the cloud's major axis, in degrees."""
+    traj, ens, meas, _, _ = data
+    assert traj.angle.attrs["units"] == "rad"
+    k = int(traj.attrs["investigated_step"])
+    at = np.nonzero(traj.frame_step.values == k)[0]
+    if len(at):
+        step_turn = float(traj.attrs["h"]) * np.abs(traj.frame_spin.values[at[0]]).max()
+        assert np.abs(traj.frame_angle.values[at[0]] - traj.angle.values).max() <= 2 * step_turn + 1e-12
+    assert meas.angle.attrs["units"] == "degree" and "major principal axis" in meas.angle.attrs["long_name"]
+    ax, ay = ens.accel_x.isel(tol=-1), ens.accel_y.isel(tol=-1)
+    dx, dy = ax - ax.mean("run"), ay - ay.mean("run")
+    expect = np.degrees(0.5 * np.arctan2(2 * (dx * dy).mean("run"), (dx * dx).mean("run") - (dy * dy).mean("run")))
+    expect = xr.where(expect <= -90, expect + 180, expect)
+    got = meas.angle.isel(tol=-1)
+    elongated = (meas.ratio.isel(tol=-1) < 0.5) & (meas.major.isel(tol=-1) > 1e-9)
+    assert bool(elongated.any())
+    np.testing.assert_allclose(got.where(elongated).transpose("init", "disc").values,
+                               expect.where(elongated).transpose("init", "disc").values, atol=1e-6)
