@@ -307,7 +307,7 @@ def test_report_caption_counts_the_runs(data):
     zero = ens.zero_guess.values == 1
     assert f"of {int(zero.sum())} zero-guess runs let the disc fall" in text
     assert f"{int((ens.outcome.values == 1).sum())} of {int((~zero).sum())} random-guess runs keep it wedged" in text
-    publish_parts(text, writer_name="html", settings_overrides={"report_level": 2, "halt_level": 2})
+    publish_parts(text, writer="html", settings_overrides={"report_level": 2, "halt_level": 2})
 
 
 def test_labels_say_what_the_variables_hold(data):

@@ -197,7 +197,7 @@ def test_captions_state_the_finding():
 
     for text in (SP.caption(small_table()), WP.caption(small_nlgs(), small_integration())):
         assert "<" not in text and "TODO" not in text
-        publish_parts(text, writer_name="html", settings_overrides={"report_level": 2, "halt_level": 2})
+        publish_parts(text, writer="html", settings_overrides={"report_level": 2, "halt_level": 2})
     assert "bounded in 4 of 4 runs" in SP.caption(small_table()) and "3 of its stable runs are inaccurate" in \
         SP.caption(small_table())
     assert "rest 4 to 4; flow 0.5 to 0.5" in WP.caption(small_nlgs(), small_integration())
