@@ -265,8 +265,9 @@ def plot(traj, ens, meas, cfg):
     ax.set_aspect("equal")
     ax.set_xlabel("x along the ground (m); the flow goes to the right")
     ax.set_title(f"(a) step {int(traj.attrs['investigated_step'])}: zero-guess spread of each grain at tol "
-                 f"{tight:.0e}; grain {grain} in red; black: contacts that switch", fontsize=10)
-    fig.colorbar(pc, ax=ax, label="spread (m/s²)", shrink=0.9, pad=0.01)
+                 f"{tight:.0e}\ngrain {grain} in red; black: contacts that switch status", fontsize=10)
+    ax.set_anchor("C")
+    fig.colorbar(pc, cax=ax.inset_axes([1.02, 0.06, 0.02, 0.88]), label="spread (m/s²)")
 
     wx = float(ens.accel_x.sel(init="warm", tol=tight, disc=grain).mean())
     wy = float(ens.accel_y.sel(init="warm", tol=tight, disc=grain).mean())
