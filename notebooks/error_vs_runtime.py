@@ -60,8 +60,8 @@ df = xr.load_dataset(snakemake.input.integration).to_dataframe()
 results = results_dir(snakemake)
 
 # %%
-save(page.plot(nl, df), snakemake.output, dpi=100, show=True)
 Path(snakemake.output.png).with_suffix(".caption.rst").write_text(page.caption(nl, df))
+save(page.plot(nl, df), snakemake.output, dpi=100, show=True)
 
 # %% [markdown]
 # (a–c) Distance of the end-of-step velocities to the limit against wall time, one point

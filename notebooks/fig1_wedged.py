@@ -57,8 +57,8 @@ wedge = Wedge.from_config(cfg)
 results = results_dir(snakemake)
 
 # %%
-save(page.plot(ens, evo, swp, wedge), snakemake.output, dpi=100, show=True)
 Path(snakemake.output.png).with_suffix(".caption.rst").write_text(page.caption(ens, swp, wedge))
+save(page.plot(ens, evo, swp, wedge), snakemake.output, dpi=100, show=True)
 
 # %% [markdown]
 # (a) $B$ between the two fixed discs, the Coulomb cones (orange), the lines of action of

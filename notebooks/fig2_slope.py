@@ -61,8 +61,8 @@ meas, census = xr.load_dataset(_smk.input.measures), xr.load_dataset(_smk.input.
 results = results_dir(_smk)
 
 # %%
-save(page.plot(traj, ens, meas, cfg), _smk.output, dpi=100, show=True)
 Path(_smk.output.png).with_suffix(".caption.rst").write_text(page.caption(ens, meas))
+save(page.plot(traj, ens, meas, cfg), _smk.output, dpi=100, show=True)
 
 # %% [markdown]
 # (a) The flow at the investigated step, each grain coloured by its zero-guess spread at the

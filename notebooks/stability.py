@@ -56,8 +56,8 @@ results = results_dir(snakemake)
 
 # %%
 fig = page.plot(tab)
-save(fig, snakemake.output, dpi=100, show=True)
 Path(snakemake.output.png).with_suffix(".caption.rst").write_text(page.caption(tab))
+save(fig, snakemake.output, dpi=100, show=True)
 
 # %% [markdown]
 # (a) Every run: a circle per CD run above its case, a square per MD run below, coloured by
