@@ -42,6 +42,8 @@
 # reference's own uncertainty).
 
 # %%
+from pathlib import Path
+
 import matplotlib
 import xarray as xr
 from IPython.display import HTML, Markdown, display
@@ -58,6 +60,7 @@ df = xr.load_dataset(snakemake.input.integration).to_dataframe()
 results = results_dir(snakemake)
 
 # %%
+Path(snakemake.output.png).with_suffix(".caption.rst").write_text(page.caption(nl, df))
 save(page.plot(nl, df), snakemake.output, dpi=100, show=True)
 
 # %% [markdown]

@@ -37,6 +37,8 @@
 # neighbour, tunnels through a disc or stops NLGS at its sweep budget on some step.
 
 # %%
+from pathlib import Path
+
 import matplotlib
 import xarray as xr
 from IPython.display import HTML, Markdown, display
@@ -54,6 +56,7 @@ results = results_dir(snakemake)
 
 # %%
 fig = page.plot(tab)
+Path(snakemake.output.png).with_suffix(".caption.rst").write_text(page.caption(tab))
 save(fig, snakemake.output, dpi=100, show=True)
 
 # %% [markdown]

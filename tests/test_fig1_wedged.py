@@ -255,3 +255,69 @@ def test_evolutions_fall_and_stay_wedged(data):
     fn0, ft0 = w.forces(cfg["evolution"]["wedge_factor"] * w.n_min)
     np.testing.assert_allclose(stay.force_n.values[1:], np.broadcast_to(fn0, stay.force_n.values[1:].shape), rtol=1e-8)
     np.testing.assert_allclose(stay.force_t.values[1:], np.broadcast_to(ft0, stay.force_t.values[1:].shape), rtol=1e-8)
+
+
+# ---------------------------------------------------------------- the page
+def test_page_sentences_count_the_runs(data):
+    """The page's sentences quote the counts of the file, the left-out runs included."""
+    from ncd.figures import wedged_page as page
+
+    ens, w = data["ens"], data["wedge"]
+    conv, zero, out = ens.converged.values == 1, ens.zero_guess.values == 1, ens.outcome.values
+    text = page.ensemble_sentence(ens, w)
+    n_rand, n_zero = int((~zero).sum()), int(zero.sum())
+    assert (f"of the {n_rand} runs from random guesses, {int((out[conv & ~zero] == 0).sum())} fall, "
+            f"{int((out[conv & ~zero] == 1).sum())} stay wedged") in text
+    assert f"and {int((zero & ~conv).sum())} did not converge." in text
+    assert f"of the {n_zero} runs from zero guesses" in text
+    wed, n, _, _, iy = page.wedged_runs(ens)
+    span = 100 * (iy.max() - iy.min()) / (w.segment[1] - w.segment[0])
+    assert f"span {span:.1f} % of the segment" in text
+    # the contact reviewed second decides: no random run below N_min there wedges
+    second = 1 - ens.first_reviewed.values
+    guess = ens.guess_force_n.values[np.arange(ens.sizes["run"]), second]
+    assert not np.any(out[conv & ~zero & (guess < w.n_min)] == 1)
+    assert "of the" in page.second_contact_sentence(ens, w) and ", 0 %." in page.second_contact_sentence(ens, w)
+
+
+def test_page_figure_is_readable(data):
+    from figure_checks import problems
+
+    from ncd.figures import wedged_page as page
+
+    assert problems(page.plot(data["ens"], data["evo"], data["sweep"], data["wedge"])) == []
+
+
+def test_page_sweep_sentence_matches_the_closed_form_threshold(data):
+    from ncd.figures import wedged_page as page
+
+    swp, w = data["sweep"], data["wedge"]
+    text = page.sweep_sentence(swp, w, data["cfg"]["ensemble"]["force_max"])
+    assert "the wedged fraction is 0 at most below" in text
+    assert f"{swp.sizes['gamma']} friction angles" in text
+
+
+def test_report_caption_counts_the_runs(data):
+    from docutils.core import publish_parts
+
+    from ncd.figures import wedged_page as page
+
+    ens, w = data["ens"], data["wedge"]
+    text = page.caption(ens, data["sweep"], w)
+    zero = ens.zero_guess.values == 1
+    assert f"of {int(zero.sum())} zero-guess runs let the disc fall" in text
+    assert f"{int((ens.outcome.values == 1).sum())} of {int((~zero).sum())} random-guess runs keep it wedged" in text
+    publish_parts(text, writer="html", settings_overrides={"report_level": 2, "halt_level": 2})
+
+
+def test_labels_say_what_the_variables_hold(data):
+    """``wedged_fraction`` counts converged runs only (its label says so); the evolutions'
+    ``angle`` is B's rotation in radians (it was labelled degrees): B, symmetric between the
+    two obstacles, does not turn."""
+    swp, evo = data["sweep"], data["evo"]
+    conv = swp.converged == 1
+    expect = ((swp.outcome == 1) & conv).sum("run") / conv.sum("run")
+    np.testing.assert_allclose(swp.wedged_fraction.values, expect.values, equal_nan=True)
+    assert "converged" in swp.wedged_fraction.attrs["long_name"]
+    assert evo.angle.attrs["units"] == "rad" and "rotation" in evo.angle.attrs["long_name"]
+    assert float(np.abs(evo.angle).max()) < 1e-9

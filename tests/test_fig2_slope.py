@@ -185,20 +185,60 @@ def test_spread_against_tolerance_supports_the_verdict(data):
 def test_the_notebook_states_the_verdict_and_the_cloud_shape(data, results):
     _, ens, meas, _, an = data
     nb = json.loads((results / "notebooks" / "fig2_slope.ipynb").read_text())
-    text = "".join("".join(o.get("text", "")) for c in nb["cells"] if c["cell_type"] == "code"
-                   for o in c.get("outputs", []))
-    assert f"VERDICT: {meas.attrs['verdict']}." in text
+    outputs = [o for c in nb["cells"] if c["cell_type"] == "code" for o in c.get("outputs", [])]
+    md = "".join("".join(o.get("data", {}).get("text/markdown", "")) for o in outputs)
+    html = "".join("".join(o.get("data", {}).get("text/html", "")) for o in outputs)
+    assert not any(o.get("name") == "stdout" for o in outputs), "the page prints a log"
+    assert f"Verdict of the rule below: **{meas.attrs['verdict']}**" in md
     grain = int(meas.attrs["grain"])
     ratio = float(meas.ratio.sel(init="zero", tol=ens.tol.min(), disc=grain))
-    assert f"minor/major {ratio:.2e}" in text
+    assert f"{ratio:.1e}" in html
     # the prose describes the cloud from the census (which solutions, how far from them)
     from ncd.figures import census as cs
-    md = "".join("".join(o.get("data", {}).get("text/markdown", "")) for c in nb["cells"] if c["cell_type"] == "code"
-                 for o in c.get("outputs", []))
     cen = xr.load_dataset(results / "fig2_slope" / "census.nc")
     cloud = sa.cloud_against_census(ens, cen, grain, "zero")
     assert cs.cloud_text(cloud, grain, float(ens.tol.min()), an["line_ratio"]) in md
     assert "two isolated solutions" not in md and "line is made of two points" not in md
+
+
+def test_spread_is_the_rms_distance_to_the_mean(data):
+    """``spread`` (measures.nc) is what its long_name says: per init, tolerance and grain, the
+    root mean square over the runs of the distance of the acceleration to its mean (not the
+    largest distance, which is larger wherever a cloud has more than two points)."""
+    _, ens, meas, _, _ = data
+    ax, ay = ens.accel_x.transpose("init", "tol", "disc", "run"), ens.accel_y.transpose("init", "tol", "disc", "run")
+    dist = np.hypot(ax - ax.mean("run"), ay - ay.mean("run")).values
+    rms = np.sqrt((dist ** 2).mean(-1))
+    np.testing.assert_allclose(meas.spread.transpose("init", "tol", "disc").values, rms, rtol=1e-9, atol=1e-12)
+    assert meas.spread.attrs["long_name"].startswith("RMS distance of the acceleration to its mean")
+    assert "largest" not in meas.spread.attrs["long_name"]
+    largest = dist.max(-1)
+    moving = rms > 1e-9
+    assert np.all(largest[moving] >= rms[moving] * (1 - 1e-12))
+
+
+def test_the_page_sentences_quote_the_files(data):
+    """The page's sentences and tables count what the files hold; its figure is readable."""
+    from figure_checks import problems
+
+    from ncd.figures import slope_page as page
+
+    traj, ens, meas, _, an = data
+    cfg = {**yaml.safe_load(traj.attrs["config_yaml"]), "analysis": an}
+    grain = int(meas.attrs["grain"])
+    text = page.spread_sentence(ens, meas, cfg)
+    assert f"grain {grain}" in text and f"**{meas.attrs['verdict']}**" in text
+    n_conv = int(ens.sel(init="zero", tol=ens.tol.min()).converged.sum())
+    assert f"zero {n_conv} of {ens.sizes['run']}" in text
+    assert len(page.tolerance_table(ens, meas)) == ens.sizes["init"] * ens.sizes["tol"]
+    sol = page.solutions_sentence(meas, cfg)
+    assert f"reach {int(meas.attrs['n_solutions'])} distinct solution(s)" in sol
+    if "scan_step" in traj.dims:
+        several = int((traj.scan_zero_solutions.values > 1).sum())
+        assert f"at {several} steps from the zero guess" in page.scan_sentence(traj, cfg)
+    assert problems(page.plot(traj, ens, meas, cfg)) == []
+    cap = page.caption(ens, meas)
+    assert f"reach {int(meas.attrs['n_solutions'])} distinct solution(s)" in cap and meas.attrs["verdict"] in cap
 
 
 def _ratio(x, y, weights=None):
@@ -359,3 +399,26 @@ def test_census_solutions_are_exact_and_contain_the_nlgs_end_points(data, result
             d = max(np.abs(cen.accel_x.values[i] - cen.accel_x.values[j]).max(),
                     np.abs(cen.accel_y.values[i] - cen.accel_y.values[j]).max())
             assert d > ccfg["same_tol"] * step.g
+
+
+def test_angles_say_what_they_hold(data):
+    """``trajectory.angle`` is the discs' rotation in radians (it was labelled degrees): at the
+    investigated step it differs from the stored frame of that step by at most one step of spin.
+    ``measures.angle`` is the direction of the cloud's major axis, in degrees."""
+    traj, ens, meas, _, _ = data
+    assert traj.angle.attrs["units"] == "rad"
+    k = int(traj.attrs["investigated_step"])
+    at = np.nonzero(traj.frame_step.values == k)[0]
+    if len(at):
+        step_turn = float(traj.attrs["h"]) * np.abs(traj.frame_spin.values[at[0]]).max()
+        assert np.abs(traj.frame_angle.values[at[0]] - traj.angle.values).max() <= 2 * step_turn + 1e-12
+    assert meas.angle.attrs["units"] == "degree" and "major principal axis" in meas.angle.attrs["long_name"]
+    ax, ay = ens.accel_x.isel(tol=-1), ens.accel_y.isel(tol=-1)
+    dx, dy = ax - ax.mean("run"), ay - ay.mean("run")
+    expect = np.degrees(0.5 * np.arctan2(2 * (dx * dy).mean("run"), (dx * dx).mean("run") - (dy * dy).mean("run")))
+    expect = xr.where(expect <= -90, expect + 180, expect)
+    got = meas.angle.isel(tol=-1)
+    elongated = (meas.ratio.isel(tol=-1) < 0.5) & (meas.major.isel(tol=-1) > 1e-9)
+    assert bool(elongated.any())
+    np.testing.assert_allclose(got.where(elongated).transpose("init", "disc").values,
+                               expect.where(elongated).transpose("init", "disc").values, atol=1e-6)

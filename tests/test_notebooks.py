@@ -104,3 +104,18 @@ def test_notebook_narrates_and_the_package_computes(py):
     lines = [s for c in cells for s in c.source.splitlines() if s.strip() and not s.strip().startswith("#")]
     assert len(lines) <= CODE_LINES_MAX, f"{py.name}: {len(lines)} lines of code"
     assert not any(s.strip().startswith(("print(df", "display(df")) for s in lines)
+
+
+# pages rewritten as paper sections: analysis and plots in the package, a few lines per cell
+SECTION_PAGES = ("fig1_wedged", "fig2_slope", "stability", "error_vs_runtime")
+
+
+@pytest.mark.parametrize("name", SECTION_PAGES)
+def test_page_notebook_is_short_and_prints_no_log(name):
+    nb = jupytext.read(Path(__file__).resolve().parent.parent / "notebooks" / f"{name}.py")
+    code = [c.source for c in nb.cells if c.cell_type == "code"]
+    lines = [ln for src in code for ln in src.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
+    assert len(lines) <= 120, f"{name}: {len(lines)} lines of code"
+    body = [[ln for ln in src.splitlines() if ln.strip() and not ln.startswith(("import ", "from "))] for src in code]
+    assert max(map(len, body)) <= 12, "a cell of more than 12 lines besides its imports"
+    assert not any("print(" in src for src in code), f"{name} prints a log"

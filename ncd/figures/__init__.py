@@ -7,8 +7,8 @@ the same table: a figure's computing rules depend on the layers below and on its
 modules, so that editing one figure reruns no other.
 """
 FIGURE_MODULES = {
-    "fig1_wedged": ("wedged",),
-    "fig2_slope": ("census",),
+    "fig1_wedged": ("wedged", "wedged_page"),
+    "fig2_slope": ("census", "slope_page"),
     "fig3_equilibrium": ("equilibrium", "equilibrium_plots", "faces"),
     "fig4_pile": ("pile", "pile_exact", "pile_plots"),
     "fig4_history": ("history", "history_analysis", "history_exact", "history_plots", "history_size"),

@@ -288,6 +288,8 @@ def threshold_sweep(cfg, progress=None):
     ds["gamma"].attrs["units"] = "degree"
     ds["force_n"].attrs["long_name"] = "normal force at contact 0 (left)"
     ds["outcome"].attrs["flag_meanings"] = OUTCOMES
+    ds["wedged_fraction"].attrs["long_name"] = ("fraction of the converged runs that stay wedged (runs that did "
+                                                "not converge left out; NaN when none converged)")
     w0 = Wedge.from_config(cfg)
     ds.attrs = {**provenance(_provenance_config(cfg), s, root_seed=sw["root_seed"]), **w0.attrs(), "h": h,
                 "members": "member = gamma index * runs + run; rng = default_rng((member, sweep.root_seed))",
@@ -336,6 +338,7 @@ def evolutions(cfg, progress=None):
                             "time": ("step", h * np.arange(n_steps + 1)), "contact": np.arange(2)})
     ds["force_n"].attrs = {"units": "N", "long_name": "normal contact force on B (impulse / h of the step ending at time)"}
     ds["force_t"].attrs = {"units": "N", "long_name": "tangential contact force on B"}
+    ds["angle"].attrs = {"units": "rad", "long_name": "rotation angle of B"}
     ds.attrs = {**provenance(_provenance_config(cfg), s), **wedge.attrs(), "h": h, "theta": theta,
                 "duration": float(ev["duration"]), "wedge_factor": float(ev["wedge_factor"]),
                 "initial_force_n": fn0, "initial_force_t": ft0,

@@ -98,7 +98,7 @@ KNOWN = {
     "major": ("m s-2", "standard deviation along the major principal axis"),
     "minor": ("m s-2", "standard deviation along the minor principal axis"),
     "ratio": ("1", "minor / major principal standard deviation"),
-    "spread": ("m s-2", "spread (largest distance) of the acceleration over the runs"),
+    "spread": ("m s-2", "RMS distance of the acceleration to its mean over the runs, sqrt(major^2 + minor^2)"),
     "delta_x": ("m s-2", "x of the difference between two solutions"),
     "delta_y": ("m s-2", "y of the difference between two solutions"),
     "rigid_x": ("m s-2", "x of the rigid-motion part of the difference"),
@@ -185,7 +185,8 @@ KNOWN = {
 # name prefixes whose rest is a name of KNOWN (``scan_zero_sweeps``: sweeps of the scan, zero guess)
 PREFIXES = {"scan_zero_": "scan, zero guess: ", "scan_warm_": "scan, warm start: ",
             "deposit_": "deposition: ", "snapshot_": "stored state: "}
-SCAN = {"max_spread": ("m s-2", "largest acceleration spread"), "solutions": ("1", "distinct solutions"),
+SCAN = {"max_spread": ("m s-2", "largest RMS spread of a grain's acceleration over the converged runs (0: none converged)"),
+        "solutions": ("1", "distinct solutions among the converged runs (0: none converged)"),
         "visible": ("1", "grains with a visible dispersion")}
 
 

@@ -363,4 +363,6 @@ def measures_dataset(traj, ens, cfg):
                                   "run": ens.run.values, "solution": np.arange(len(reps)),
                                   "contact": ens.contact.values},
                     attrs=provenance(cfg["analysis"], **attrs))
+    ds["angle"].attrs = {"units": "degree", "long_name": "angle of the major principal axis of the cloud from the "
+                                                         "x axis, in (-90, 90]"}
     return ds

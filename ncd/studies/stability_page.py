@@ -216,3 +216,14 @@ def plot(tab, energy_tolerance=0.05):
                 Line2D([], [], ls="", marker="s", mfc="w", mec="k", label="MD")]
     fig.legend(handles=handles, loc="outside lower center", ncol=6, fontsize=9, frameon=False)
     return fig
+
+
+def caption(tab):
+    """The Snakemake report's caption (reStructuredText): the figure's finding, from the data."""
+    c = counts(tab)
+    return (f"**Stability (section 2).** Contact Dynamics stays bounded in {c['cd_bounded']} of {c['cd']} runs, up "
+            f"to far above the critical step of molecular dynamics, but {c['cd_inaccurate']} of its stable runs are "
+            f"inaccurate ({c['pen']} sink by more than {PENETRATION_LIMIT:g} r, {c['tunnel']} tunnel, {c['budget']} "
+            f"reach the sweep budget); its accurate runs go up to h = {c['cd_accurate_max_ratio']:.3g} h_crit. "
+            f"Molecular dynamics is unstable in {c['md_unstable']} of {c['md']} runs, from h = "
+            f"{c['md_unstable_min_ratio']:.3g} h_crit. Details: ``results/html/stability.html``.\n")

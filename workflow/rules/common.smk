@@ -108,13 +108,24 @@ def notebook_file(figure, ext="ipynb"):
     return str(REL / "notebooks" / f"{figure}.{ext}")
 
 
+# figures whose notebook writes the report caption from the data (caption_output)
+CAPTIONS_FROM_DATA = ("fig1_wedged", "fig2_slope", "stability", "error_vs_runtime")
+
+
+def caption_output(figure):
+    """``results/figures/<figure>.caption.rst``: the report caption the figure's notebook writes
+    (its finding, computed from the data), beside the PNG."""
+    return f"results/figures/{figure}.caption.rst"
+
+
 def figure_output(figure, ext):
     """``results/figures/<figure>.<ext>``, marked for ``snakemake --report report.zip`` with the
-    caption ``workflow/report/<figure>.rst`` (or the generic ``figure.rst``)."""
+    caption its notebook wrote (CAPTIONS_FROM_DATA), else ``workflow/report/<figure>.rst`` (or
+    the generic ``figure.rst``)."""
     name = figure if (ROOT / "workflow" / "report" / f"{figure}.rst").exists() else "figure"
     # a caption path is relative to the rules file (workflow/rules/)
-    return report(f"results/figures/{figure}.{ext}", caption=f"../report/{name}.rst",
-                  category=figure, subcategory=ext.upper())
+    caption = f"../../{caption_output(figure)}" if figure in CAPTIONS_FROM_DATA else f"../report/{name}.rst"
+    return report(f"results/figures/{figure}.{ext}", caption=caption, category=figure, subcategory=ext.upper())
 
 
 def figure_targets(figure):

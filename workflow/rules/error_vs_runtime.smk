@@ -51,6 +51,7 @@ rule error_vs_runtime_notebook:
     output:
         png=figure_output("error_vs_runtime", "png"),
         pdf=figure_output("error_vs_runtime", "pdf"),
+        caption=caption_output("error_vs_runtime"),
     log:
         notebook="results/notebooks/error_vs_runtime.ipynb",
     benchmark:

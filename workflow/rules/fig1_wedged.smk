@@ -86,12 +86,14 @@ rule fig1_wedged_notebook:
         ensemble="results/fig1_wedged/ensemble.nc",
         evolutions="results/fig1_wedged/evolutions.nc",
         sweep="results/fig1_wedged/sweep.nc",
+        page=page_modules(FIG),
         notebook=notebook_file("fig1_wedged"),
         notebook_py=notebook_file("fig1_wedged", "py"),
         pages=page_sources("notebook"),
     output:
         png=figure_output("fig1_wedged", "png"),
         pdf=figure_output("fig1_wedged", "pdf"),
+        caption=caption_output("fig1_wedged"),
     log:
         notebook="results/notebooks/fig1_wedged.ipynb",
     benchmark:

@@ -118,12 +118,14 @@ rule fig2_slope_notebook:
         ensemble=f"{F2}/ensemble.nc",
         measures=f"{F2}/measures.nc",
         census=f"{F2}/census.nc",
+        page=page_modules(FIG2),
         notebook=notebook_file(FIG2),
         notebook_py=notebook_file(FIG2, "py"),
         pages=page_sources("notebook"),
     output:
         png=figure_output(FIG2, "png"),
         pdf=figure_output(FIG2, "pdf"),
+        caption=caption_output(FIG2),
     params:
         config=without_shards(CFG2),
     log:

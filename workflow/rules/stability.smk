@@ -32,6 +32,7 @@ rule stability_notebook:
     output:
         png=figure_output("stability", "png"),
         pdf=figure_output("stability", "pdf"),
+        caption=caption_output("stability"),
     log:
         notebook="results/notebooks/stability.ipynb",
     benchmark:
