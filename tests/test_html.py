@@ -2,6 +2,9 @@
 folded, maths typeset offline, every figure shown.  ``slow`` tests open the pages in
 Debian's headless chromium (skipped without it) and keep screenshots under
 ``results/screenshots/``."""
+import base64
+import io
+import json
 import re
 import shutil
 import subprocess
@@ -169,10 +172,6 @@ def probed_dom(page, tmp_path):
 
 def figure_layouts(dom):
     """(rendered / natural width, text layout) of every PNG of the page saved by ncd.pages.notebook.save."""
-    import base64
-    import io
-    import json
-
     from PIL import Image
 
     from ncd.pages.notebook import LAYOUT_KEY

@@ -13,6 +13,7 @@ next pages and the paper (:func:`nav_header`).
 """
 import re
 import shutil
+from html import escape
 from pathlib import Path
 
 import nbformat
@@ -123,8 +124,6 @@ def neighbours(name, pages):
 
 def nav_header(name, pages):
     """The ``<nav>`` opening a page: the index, the previous and next pages, the paper on HAL."""
-    from html import escape
-
     prev, nxt = neighbours(name, pages)
 
     def link(page, arrow):
