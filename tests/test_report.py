@@ -1,15 +1,60 @@
-"""results/index.html: claims read from the data, "not computed" when data are missing,
-new figures listed, run times from the benchmark files."""
+"""results/index.html and the claims table: every sentence of the paper has a row, the
+verdicts follow the data, missing data give "not computed", run times come from the
+benchmark files."""
+import re
+from pathlib import Path
+
 import numpy as np
+import pytest
 import xarray as xr
 
-from ncd.pages.report import CLAIMS, DIFFERS, NOT_COMPUTED, REPRODUCED, build_page, evaluate, fig1_threshold, run_times
+from ncd.core.verdict import DIFFERS, NOT_COMPUTED, NOT_TESTED, REPRODUCED, VERDICTS
+from ncd.figures import FIGURE_MODULES
+from ncd.pages import claims as C
+from ncd.pages.report import build_page, claim_rows, run_times, section_of
+
+ROOT = Path(__file__).resolve().parents[1]
+PAPER = ROOT.parent / "shared" / "paper" / "moreau-2005-indetermination.txt"
+MATH = (("\\mathbf{R}^{2\\kappa}", "R^2κ"), ("\\kappa", "κ"), ("\\gamma", "γ"), ("\\rho", "ρ"), ("\\alpha", "α"),
+        ("\\cap", "∩"), ("t_0", "t0"), ("-", "−"), ("$", ""), ("*", ""), ("{", ""), ("}", ""), ("\\", ""))
 
 
-def test_missing_data_gives_not_computed_and_the_page_builds(tmp_path):
-    assert all(evaluate(c, tmp_path).verdict == NOT_COMPUTED for c in CLAIMS)
+def _normal(text):
+    text = re.sub(r"-\s*\n\s*\n\s*", "", text)          # a word split over the paper's page break
+    for a, b in MATH:
+        text = text.replace(a, b)
+    return re.sub(r"\s+", "", text)
+
+
+def test_every_claim_is_judged_or_has_a_reason():
+    ids = {c["id"] for c in C.CLAIMS}
+    assert set(C.MEASURES) <= ids and set(C.UNTESTED_REASONS) <= ids
+    for c in C.CLAIMS:
+        figs = [f for f, _ in C.MEASURES.get(c["id"], [])]
+        assert figs or c["id"] in C.UNTESTED_REASONS, c["id"]
+        assert sorted(figs) == sorted(c["figures"]), (c["id"], figs, c["figures"])
+        assert section_of(c) in c["section"]
+    known = set(FIGURE_MODULES) | {"stability", "error_vs_runtime"}
+    assert {f for c in C.CLAIMS for f in c["figures"]} <= known
+
+
+@pytest.mark.skipif(not PAPER.exists(), reason="the paper's text is not beside the checkout")
+def test_every_quote_is_the_papers_wording():
+    paper = _normal(PAPER.read_text(encoding="utf-8"))
+    missing = [c["id"] for c in C.CLAIMS if _normal(c["quote"]) not in paper]
+    assert not missing, f"quotes not found in the paper: {missing}"
+
+
+def test_every_claim_has_a_row_on_the_index(tmp_path):
     page = build_page(tmp_path, ["fig1_wedged", "fig9_new"], {"fig1_wedged": {"mu": 0.75}})
-    assert page.count("not computed") >= len(CLAIMS) and "fig9_new" in page and "config digest" in page
+    for c in C.CLAIMS:
+        assert f"id='{c['id']}'" in page, c["id"]
+    rows = claim_rows(tmp_path)
+    assert all(v.verdict in VERDICTS for _, _, v in rows)
+    # without data every measured claim is "not computed", every other "not tested"; the page builds
+    for c, fig, v in rows:
+        assert v.verdict == (NOT_COMPUTED if fig else NOT_TESTED), (c["id"], v)
+    assert "fig9_new" in page and "config digest" in page
 
 
 def _sweep(tmp_path, fractions):
@@ -22,10 +67,62 @@ def _sweep(tmp_path, fractions):
 
 def test_threshold_verdict_follows_the_data(tmp_path):
     _sweep(tmp_path, [0.0, 0.0, 0.4, 0.6])
-    m = fig1_threshold(tmp_path)
+    m = C.fig1_threshold(tmp_path)
     assert m.verdict == REPRODUCED and "first at 25.0°" in m.value
     _sweep(tmp_path, [0.0, 0.1, 0.4, 0.6])  # wedging below the threshold: the claim fails
-    assert fig1_threshold(tmp_path).verdict == DIFFERS
+    assert C.fig1_threshold(tmp_path).verdict == DIFFERS
+
+
+def _cuts(tmp_path, x, fx, cloud):
+    """Scan cuts at ``x`` (one flank) with history resultants ``(fx, 0)``, a default cut at
+    x[0], and zero-guess runs at rest whose resultants at the default cut are ``cloud``."""
+    n = len(x) + 1
+    kind = np.array(["default"] + ["scan"] * len(x))
+    cuts = xr.Dataset({"kind": ("cut", kind), "cut_x": ("cut", np.r_[x[0], x]), "outer": ("cut", np.ones(n)),
+                       "history_fx": ("cut", np.r_[fx[0], fx]), "history_fy": ("cut", np.zeros(n))},
+                      attrs={"mean_diameter": 1.0})
+    runs = len(cloud)
+    fxr = np.zeros((runs, n))
+    fxr[:, 0] = cloud
+    ens = xr.Dataset({"outcome": ("run", np.ones(runs, int)), "cut_force_x": (("run", "cut"), fxr),
+                      "cut_force_y": (("run", "cut"), np.zeros((runs, n)))})
+    (tmp_path / "fig4_pile").mkdir(exist_ok=True)
+    cuts.to_netcdf(tmp_path / "fig4_pile" / "cuts.nc")
+    ens.to_netcdf(tmp_path / "fig4_pile" / "ensemble.nc")
+
+
+def test_cut_position_is_a_may_over_pairs_of_cuts(tmp_path):
+    # cuts one diameter apart: changes 1.0, 0.1, 0.1; the cloud is 0.2 across
+    _cuts(tmp_path, [0.0, 1.0, 2.0, 3.0], [0.0, 1.0, 1.1, 1.2], [0.0, 0.2])
+    v = C.fig4_cut_vs_cloud(tmp_path)
+    assert v.verdict == REPRODUCED and "3 pairs" in v.value and "33.3 % of pairs" in v.value
+    _cuts(tmp_path, [0.0, 1.0, 2.0, 3.0], [0.0, 0.3, 0.6, 0.9], [0.0, 0.2])   # every change below 0.4
+    assert C.fig4_cut_vs_cloud(tmp_path).verdict == DIFFERS
+
+
+def _measures(tmp_path, zero, warm):
+    tol = np.array([1e-3, 1e-5, 1e-8])
+    sp = np.zeros((2, 3, 1))
+    sp[0, :, 0], sp[1, :, 0] = zero, warm
+    ds = xr.Dataset({"spread": (("init", "tol", "disc"), sp)},
+                    coords={"init": ["zero", "warm"], "tol": tol, "disc": [0]}, attrs={"grain": 0})
+    (tmp_path / "fig2_slope").mkdir(exist_ok=True)
+    ds.to_netcdf(tmp_path / "fig2_slope" / "measures.nc")
+
+
+def test_warm_start_judged_where_the_zero_guess_spread_has_settled(tmp_path):
+    _measures(tmp_path, [0.5, 5.4, 5.6], [0.4, 0.05, 1e-5])     # loose tolerance: both are iteration error
+    assert C.warm_little(tmp_path).verdict == REPRODUCED
+    _measures(tmp_path, [0.5, 5.4, 5.6], [0.4, 0.9, 1e-5])      # at 1e-5 the warm spread is not small
+    assert C.warm_little(tmp_path).verdict == DIFFERS
+
+
+def test_claim_markdown_carries_the_index_verdict_and_anchor(tmp_path):
+    _sweep(tmp_path, [0.0, 0.0, 0.4, 0.6])
+    text = C.claim_markdown("s1-wedging-threshold", tmp_path)
+    assert '<a id="claim-s1-wedging-threshold"></a>' in text and f"**{REPRODUCED}**" in text
+    rows = dict((c["id"], v) for c, _, v in claim_rows(tmp_path) if c["id"] == "s1-wedging-threshold")
+    assert rows["s1-wedging-threshold"].value in text
 
 
 def test_run_times_sum_the_benchmark_files(tmp_path):
@@ -35,3 +132,25 @@ def test_run_times_sum_the_benchmark_files(tmp_path):
         (d / f"{name}.tsv").write_text(f"s\th:m:s\tmax_rss\n{s}\t0:00:0{int(s)}\t100\n")
     assert run_times(tmp_path, "fig1_wedged") == (2, 6.5)
     assert run_times(tmp_path, "absent") == (0, 0.0)
+
+
+def test_each_page_states_the_index_verdict(results):
+    """On the run's pages: every claim a figure judges is printed on that figure's page,
+    under the anchor the index links to, with the same verdict and the same value."""
+    import html as html_lib
+
+    wrong = []
+    for c, fig, v in claim_rows(results):
+        if not fig:
+            continue
+        page = results / "html" / f"{fig}.html"
+        text = page.read_text(encoding="utf-8") if page.exists() else ""
+        at = text.find(f'id="{C.anchor(c["id"])}"')
+        if at < 0:
+            wrong.append((c["id"], fig, "no anchor"))
+            continue
+        end = text.find('id="claim-', at + 10)
+        block = html_lib.unescape(re.sub(r"<[^>]+>", "", text[at:end if end > 0 else at + 20000]))
+        if v.verdict not in block or v.value[:60] not in block:
+            wrong.append((c["id"], fig, v.verdict))
+    assert not wrong, wrong

@@ -142,3 +142,11 @@ def save(fig, output, dpi=130, show=False, **kwargs):
         from IPython.display import Image, display
 
         display(Image(filename=str(output.png)))
+
+
+def results_dir(io):
+    """The ``results/`` folder of a run, from the Snakemake object (or :func:`paths`' stand-in)
+    of a notebook: the parent of its first input's figure folder."""
+    inputs = io.input          # Snakemake's Namedlist is a list; the stand-in a namespace
+    first = inputs[0] if isinstance(inputs, (list, tuple)) else next(iter(vars(inputs).values()))
+    return Path(first).resolve().parents[1]

@@ -51,7 +51,9 @@ STUDY_MODULES = {
     "bench": ("bench.py", "peer.py", "finish_bench.py", "c_sweep.c"),
 }
 # the page modules a page rule reads (notebook helpers, the HTML renderer, the index page)
-PAGE_MODULES = {"notebook": ("notebook.py",), "render": ("render.py",), "report": ("report.py",)}
+# (a figure's page and the index print the claims of ncd/pages/claims.py: both read it)
+PAGE_MODULES = {"notebook": ("notebook.py", "claims.py", "paper_claims.yaml"), "render": ("render.py",),
+                "report": ("report.py", "claims.py", "paper_claims.yaml")}
 
 
 def ncd_sources(figure):
