@@ -48,10 +48,13 @@
 # the pile's own free surface. Bands are bootstrap resamples of the **piles**.
 
 # %%
+from pathlib import Path
+
 import xarray as xr
 from IPython.display import Markdown, display
 
 from ncd.figures import history_plots as hp
+from ncd.pages.claims import claim_markdown
 from ncd.pages.notebook import save, write_finding
 
 try:
@@ -69,6 +72,7 @@ except NameError:  # by hand, from the repository root after `snakemake -j2 fig4
     out = SimpleNamespace(png="results/figures/fig4_history.png", pdf="results/figures/fig4_history.pdf",
                           finding="results/figures/fig4_history.finding.rst")
 an = xr.load_dataset(inp.analysis)
+results = Path(inp.analysis).resolve().parents[1]
 piles = [xr.load_dataset(inp.point), xr.load_dataset(inp.rain)]
 
 # %%
@@ -91,7 +95,13 @@ display(Markdown(hp.shapes_text(an, cfg)))
 display(Markdown(hp.stress_text(an)))
 
 # %%
+display(Markdown(claim_markdown("s5-dip", results, "fig4_history")))
+
+# %%
 display(Markdown(hp.experiments_text(an) + "\n\n" + hp.arching_text(an)))
+
+# %%
+display(Markdown(claim_markdown("s5-parallel-to-surface", results, "fig4_history")))
 
 # %% [markdown]
 # **Exact ranges (sections 4-5).** The history forces are one point of the set

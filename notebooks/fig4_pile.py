@@ -39,11 +39,13 @@ import xarray as xr
 from IPython.display import Markdown, display
 
 from ncd.figures import pile_plots as pp
-from ncd.pages.notebook import paths, save, write_finding
+from ncd.pages.claims import claim_markdown
+from ncd.pages.notebook import paths, results_dir, save, write_finding
 
 # Snakemake's object, or by hand (from the repository or notebooks/) the files under results/
 _smk = paths("fig4_pile", ["construction", "cuts", "ensemble", "tolerance", "exact"], globals().get("snakemake"))
 inp, out, cfg = _smk.input, _smk.output, _smk.params.config
+results = results_dir(_smk)
 data = {n: xr.load_dataset(getattr(inp, n)) for n in ("construction", "cuts", "ensemble", "tolerance", "exact")}
 r = pp.PileRun(data["construction"], data["cuts"], data["ensemble"], data["exact"], cfg)
 save(pp.figure(r), out, dpi=130, show=True)
@@ -115,11 +117,23 @@ display(Markdown(pp.construction_text(r)))
 # %%
 display(Markdown(pp.arching_text(r)))
 
+# %%
+display(Markdown(claim_markdown("s5-parallel-to-surface", results, "fig4_pile")))
+
+# %%
+display(Markdown(claim_markdown("s5-ten-contacts", results, "fig4_pile")))
+
 # %% [markdown]
 # ## The indetermination cloud of the default cut
 
 # %%
 display(Markdown(pp.cloud_text(r) + "\n\n" + pp.tolerance_text(r, data["tolerance"])))
+
+# %%
+display(Markdown(claim_markdown("s5-cloud", results, "fig4_pile")))
+
+# %%
+display(Markdown(claim_markdown("s5-cut-position", results, "fig4_pile")))
 
 # %% [markdown]
 # ## The exact set of the final state
@@ -136,6 +150,12 @@ display(Markdown(pp.cloud_text(r) + "\n\n" + pp.tolerance_text(r, data["toleranc
 # %%
 display(Markdown(pp.exact_text(data["exact"], data["ensemble"], data["cuts"])))
 
+# %%
+display(Markdown(claim_markdown("s5-geometry-enough", results, "fig4_pile")))
+
+# %%
+display(Markdown(claim_markdown("s6-reassuring", results, "fig4_pile")))
+
 # %% [markdown]
 # ## Ground pressure (beyond the paper)
 #
@@ -147,6 +167,12 @@ display(Markdown(pp.exact_text(data["exact"], data["ensemble"], data["cuts"])))
 
 # %%
 display(Markdown(pp.pressure_text(r) + "\n\n" + pp.dip_sentence(data["exact"])))
+
+# %%
+display(Markdown(claim_markdown("s5-pressure-not-height", results, "fig4_pile")))
+
+# %%
+display(Markdown(claim_markdown("s5-dip", results, "fig4_pile")))
 
 # %% [markdown]
 # ## Where the reproduction differs
