@@ -157,7 +157,7 @@ display(Markdown(claim_markdown("s5-geometry-enough", results, "fig4_pile")))
 display(Markdown(claim_markdown("s6-reassuring", results, "fig4_pile")))
 
 # %% [markdown]
-# ## Ground pressure (beyond the paper)
+# ## Ground pressure
 #
 # The paper quotes measurements in which the ground pressure "does not relate to the
 # height of material above", possibly with a minimum under the apex. The dip depth is
