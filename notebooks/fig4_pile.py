@@ -66,7 +66,7 @@ write_finding(out, pp.finding(r))
 #
 # 1. *Construction* (`construction.nc`): polydisperse discs (radii uniform in
 #    $[0.8, 1.2]$ mm) are poured from a row of insertion sites above $x = 0$
-#    onto a rough ground (a row of touching fixed discs), with friction 0.5
+#    onto a rough ground (a row of touching fixed discs), with friction $\mu = 0.5$
 #    everywhere and no restitution. Every step is a Moreau–Jean step with
 #    warm-started NLGS; a batch of grains is inserted at the free sites every few
 #    steps. The source stays a fixed drop height above the settled grains under
@@ -75,7 +75,7 @@ write_finding(out, pp.finding(r))
 #    (one step from $u_i = 0$, warm guess) gives $u_f = 0$ within $10^{-6}\,g h$.
 #    Its forces $r = s/h$ are the *history* forces.
 # 2. *Free surface* (`cuts.nc`): the highest disc top per one-diameter bin, and
-#    a straight line fitted to each flank between 20 % and 80 % of the apex
+#    a straight line fitted to each flank between $20\,\%$ and $80\,\%$ of the apex
 #    height: the angle of repose.
 # 3. *Cut resultant*: for a vertical cut at $x_c$, the sum of the forces exerted
 #    by the grains with centres on the axis side upon the grains with centres on
