@@ -287,5 +287,5 @@ def test_report_captions_include_the_finding(tmp_path, monkeypatch):
             assert inc == f"results/figures/{rst.stem}.finding.rst", inc
             (tmp_path / inc).parent.mkdir(parents=True, exist_ok=True)
             (tmp_path / inc).write_text(f"Measured for {rst.stem}: 0.123 N.\n")
-            html = publish_parts(text, writer_name="html")["body"]
+            html = publish_parts(text, writer="html")["body"]
             assert f"Measured for {rst.stem}: 0.123 N." in html
