@@ -289,3 +289,25 @@ def test_report_captions_include_the_finding(tmp_path, monkeypatch):
             (tmp_path / inc).write_text(f"Measured for {rst.stem}: 0.123 N.\n")
             html = publish_parts(text, writer="html")["body"]
             assert f"Measured for {rst.stem}: 0.123 N." in html
+
+
+def test_save_records_the_layout_in_the_png(tmp_path):
+    """The PNG written by ``save`` carries its text layout at the saved dpi; the figure keeps its
+    own dpi for the notebook's display."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from PIL import Image
+
+    from ncd.pages.notebook import LAYOUT_KEY, save
+
+    fig, ax = plt.subplots(figsize=(4, 3), dpi=72)
+    ax.set_title("(a) a title")
+    ax.set_xlabel("x", fontsize=11)
+    out = type("Out", (), {"png": str(tmp_path / "f.png"), "pdf": str(tmp_path / "f.pdf")})()
+    save(fig, out, dpi=150)
+    lay = json.loads(Image.open(out.png).text[LAYOUT_KEY])
+    assert lay["dpi"] == 150 and lay["overlaps"] == [] and lay["width_in"] == 4 and fig.dpi == 72
+    assert lay["min_font_pt"] == min(11, ax.xaxis.get_ticklabels()[0].get_fontsize())
+    plt.close(fig)
