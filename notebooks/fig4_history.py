@@ -15,7 +15,7 @@
 # ---
 
 # %% [markdown]
-# # Figure 4, history as statistics: piles from a point source and from a rain
+# # Beyond the paper (section 5): history as statistics — piles from a point source and from a rain
 #
 # **What the paper says (section 5).** Measurements on sand piles poured from a
 # localized source show a ground-pressure minimum under the apex; the messages from
