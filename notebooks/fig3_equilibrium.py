@@ -36,11 +36,12 @@ import xarray as xr
 from IPython.display import Markdown, display
 
 from ncd.figures import equilibrium_plots as ep
-from ncd.pages.notebook import paths, save, write_finding
+from ncd.pages.claims import claim_markdown
+from ncd.pages.notebook import paths, results_dir, save, write_finding
 
 # Snakemake's object, or by hand (from the repository or notebooks/) the files under results/
 _smk = paths("fig3_equilibrium", ["state", "ensemble", "projection", "uniform"], globals().get("snakemake"))
-inp, out = _smk.input, _smk.output
+inp, out, results = _smk.input, _smk.output, results_dir(_smk)
 r = ep.Fig3Run(*(xr.load_dataset(getattr(inp, n)) for n in ("state", "ensemble", "projection", "uniform")))
 save(ep.figure(r), out, dpi=130, show=True)
 write_finding(out, ep.finding(r))
@@ -82,11 +83,23 @@ write_finding(out, ep.finding(r))
 # %%
 display(Markdown(ep.packing_text(r)))
 
+# %%
+display(Markdown(claim_markdown("s4-dimension-A", results, "fig3_equilibrium")))
+
+# %%
+display(Markdown(claim_markdown("s4-force-set", results, "fig3_equilibrium")))
+
+# %%
+display(Markdown(claim_markdown("s2-equilibrium-test", results, "fig3_equilibrium")))
+
 # %% [markdown]
 # ## Every converged run lies in $A \cap C$
 
 # %%
 display(Markdown(ep.convergence_text(r)))
+
+# %%
+display(Markdown(claim_markdown("s4-in-cones", results, "fig3_equilibrium")))
 
 # %% [markdown]
 # ## Coverage, spread and density of the clouds
@@ -98,6 +111,12 @@ display(Markdown(ep.convergence_text(r)))
 
 # %%
 display(Markdown(ep.measures_table(r) + "\n\n" + ep.findings_text(r)))
+
+# %%
+display(Markdown(claim_markdown("s4-outlines", results, "fig3_equilibrium")))
+
+# %%
+display(Markdown(claim_markdown("s2-warm-accelerates", results, "fig3_equilibrium")))
 
 # %% [markdown]
 # ## Ghost images: where the solutions lie in $\mathbf{R}^{2\kappa}$
@@ -111,6 +130,12 @@ display(Markdown(ep.measures_table(r) + "\n\n" + ep.findings_text(r)))
 
 # %%
 display(Markdown(ep.faces_text(r)))
+
+# %%
+display(Markdown(claim_markdown("s4-ghost-images", results, "fig3_equilibrium")))
+
+# %%
+display(Markdown(claim_markdown("s4-denser-boundary", results, "fig3_equilibrium")))
 
 # %% [markdown]
 # ## Where the reproduction differs

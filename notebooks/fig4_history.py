@@ -15,7 +15,7 @@
 # ---
 
 # %% [markdown]
-# # Figure 4, history as statistics: piles from a point source and from a rain
+# # Beyond the paper (section 5): history as statistics — piles from a point source and from a rain
 #
 # **What the paper says (section 5).** Measurements on sand piles poured from a
 # localized source show a ground-pressure minimum under the apex; the messages from
@@ -48,10 +48,13 @@
 # the pile's own free surface. Bands are bootstrap resamples of the **piles**.
 
 # %%
+from pathlib import Path
+
 import xarray as xr
 from IPython.display import Markdown, display
 
 from ncd.figures import history_plots as hp
+from ncd.pages.claims import claim_markdown
 from ncd.pages.notebook import save, write_finding
 
 try:
@@ -69,8 +72,8 @@ except NameError:  # by hand, from the repository root after `snakemake -j2 fig4
     out = SimpleNamespace(png="results/figures/fig4_history.png", pdf="results/figures/fig4_history.pdf",
                           finding="results/figures/fig4_history.finding.rst")
 an = xr.load_dataset(inp.analysis)
+results = Path(inp.analysis).resolve().parents[1]
 piles = [xr.load_dataset(inp.point), xr.load_dataset(inp.rain)]
-s = hp.summary(an)
 
 # %%
 save(hp.figure(an, piles), out, dpi=130, show=True)
@@ -86,56 +89,19 @@ write_finding(out, hp.finding(an))
 # range over $A \cap C$ of single piles).
 
 # %%
-P, R = s["point"], s["rain"]
-k = s["kernel"]
-display(Markdown(f"""
-**Shapes.** The point-source piles have a base half-width $L$ of {P['L']:.1f} mean diameters,
-an apex {P['apex']:.1f} d above the ground and flanks at {P['slope']:.1f}° on average
-(apex / ($L$ tan flank) = {P['cone']:.2f}: 1 for a cone). The rain falls over $|x| \\le L$ onto
-the finite base $|x| \\le L$; {R['removed']:.1f} of the {P['grains']:.0f} poured grains roll off
-its edges on average, so the rained piles hold {R['grains_min']} to {R['grains_max']} grains
-(the point-source piles {P['grains_min']} to {P['grains_max']}; the stresses are normalised by
-each pile's own weight). The rained deposits are {R['apex']:.1f} d high with fitted flanks of
-{R['slope']:.1f}° (apex / ($L$ tan flank) = {R['cone']:.2f}):
-{'a flat layer over the base with steep edges, not a heap with flanks at the angle of repose' if R['slope'] < 0.5 * P['slope'] else 'heaps'}.
-The grains are rained gently (perfectly inelastic impacts, drop height
-{cfg['source']['drop_height_d']:g} d); the experiments' rain falls from higher, with bouncing
-grains. Much faster impacts need a smaller time step here (the grains then overlap by more
-than the overlap tolerance within one step); why the gentle rain builds a layer rather than
-a heap was not studied.
-Both histories are drawn against $x / L$ with the $L$ of the member's point-source pile.
+display(Markdown(hp.shapes_text(an, cfg)))
 
-**Ground stress ({s['piles']} piles per history, kernel {k:g} d).** Dip depth $M - m$ of the
-mean profile, in units of the mean stress $W / 2L$ (> 0 a dip): point source {P['dip']:.3f} (95 % basic bootstrap band over piles {P['lo']:.3f} to {P['hi']:.3f}),
-rain {R['dip']:.3f} ({R['lo']:.3f} to {R['hi']:.3f}); {100 * P['frac_dip']:.0f} % of the
-point-source piles and {100 * R['frac_dip']:.0f} % of the rained piles have a dip of
-their own. The difference point − rain is {s['diff']:.3f} (band {s['diff_lo']:.3f} to
-{s['diff_hi']:.3f}; permutation p = {s['p'][k]:.3g}). With the other kernel widths the
-dips of the mean profiles are
-{', '.join(f"{kk:g} d: {P['dips_by_kernel'][kk]:.3f} / {R['dips_by_kernel'][kk]:.3f}" for kk in P['dips_by_kernel'])}
-(point / rain), p = {', '.join(f"{s['p'][kk]:.3g}" for kk in s['p'])}.
-A single pile's dip is a minimum of a noisy curve against maxima of the same curve, so it
-is biased upwards when the kernel is narrow: the fraction of piles with a dip of their own is
-{', '.join(f"{kk:g} d: {100 * P['frac_by_kernel'][kk]:.0f} % / {100 * R['frac_by_kernel'][kk]:.0f} %" for kk in P['frac_by_kernel'])}
-(point / rain); only the mean profile over piles, with its band, carries a claim.
-{hp.outside_text(an)}
-Under the apex the mean stress is {P['center']:.2f} (point) and {R['center']:.2f} (rain)
-times the mean stress W / 2L.
+# %%
+display(Markdown(hp.stress_text(an)))
 
-**Against the experiments.** Vanel et al. (1999) and Geng et al. (2001) report a dip
-under point-source piles and a central maximum under rained piles. Here the
-point-source dip is {'resolved (its band excludes 0)' if P['lo'] > 0 else 'not resolved (its band includes 0 or is negative)'},
-and the rained deposit has {'a hump (negative dip, band below 0)' if R['hi'] < 0 else ('a resolved dip (band above 0), the opposite of the central maximum of the experiments' if R['lo'] > 0 else 'neither a resolved hump nor a resolved dip (band includes 0)')}.
+# %%
+display(Markdown(claim_markdown("s5-dip", results, "fig4_history")))
 
-**Arching.** Over all cuts and piles the resultant is on median {P['dev_median']:.1f}° (point)
-and {R['dev_median']:.1f}° (rain) steeper than the flank (interquartile range
-{P['dev_iqr']:.1f}° and {R['dev_iqr']:.1f}°); it is steeper than the free surface at
-{100 * P['arching']:.0f} % and {100 * R['arching']:.0f} % of the cuts that cross a contact
-({P['empty_cuts']} of {P['cuts']} point-source cuts and {R['empty_cuts']} of {R['cuts']} rain cuts,
-near the toes, cross none and have no resultant direction). (Arching here means a
-resultant steeper than the flank; the exact test of `fig4_pile` uses a weaker one, a
-resultant that pushes the bank downward, $F_y < 0$.)
-"""))
+# %%
+display(Markdown(hp.experiments_text(an) + "\n\n" + hp.arching_text(an)))
+
+# %%
+display(Markdown(claim_markdown("s5-parallel-to-surface", results, "fig4_history")))
 
 # %% [markdown]
 # **Exact ranges (sections 4-5).** The history forces are one point of the set
@@ -145,18 +111,4 @@ resultant that pushes the bank downward, $F_y < 0$.)
 # panel).
 
 # %%
-def exact_text(h):
-    x = s[h]
-    if "exact_piles" not in x:
-        return f"{hp.LABELS[h]}: no exact ranges computed."
-    return (f"{hp.LABELS[h]}, {x['exact_piles']} piles: the admissible angle at a cut spans "
-            f"{x['exact_width_median']:.1f}° on median (at most {x['exact_width_max']:.1f}°); every admissible "
-            f"state is steeper than the flank at {100 * x['exact_all_positive']:.0f} % of the cuts and every one "
-            f"shallower at {100 * x['exact_all_negative']:.0f} %; at {100 * x['exact_undefined']:.0f} % the "
-            f"admissible resultants surround zero (no angle range); the ranges are exact (a linear-fractional "
-            f"program per end, each certified to 1e-6° at {100 * x['exact_confirmed']:.0f} % of the cuts).")
-
-
-display(Markdown(" ".join(exact_text(h) for h in an.history.values)
-                 + " The arching angle of one force state is thus one choice among many: the spread of the "
-                   "history angles over piles is to be read against these ranges."))
+display(Markdown(hp.exact_text(an)))

@@ -15,7 +15,7 @@
 # ---
 
 # %% [markdown]
-# # Figure 4, history against size: piles of 10³ and 10⁴ grains
+# # Beyond the paper (section 5): history against size — piles of 10³ and 10⁴ grains
 #
 # **What the paper says (section 5).** Moreau's pile has about a thousand grains; the
 # experiments it is set against (Vanel et al. 1999; Geng et al. 2001) hold many more.

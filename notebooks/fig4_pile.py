@@ -39,11 +39,13 @@ import xarray as xr
 from IPython.display import Markdown, display
 
 from ncd.figures import pile_plots as pp
-from ncd.pages.notebook import paths, save, write_finding
+from ncd.pages.claims import claim_markdown
+from ncd.pages.notebook import paths, results_dir, save, write_finding
 
 # Snakemake's object, or by hand (from the repository or notebooks/) the files under results/
 _smk = paths("fig4_pile", ["construction", "cuts", "ensemble", "tolerance", "exact"], globals().get("snakemake"))
 inp, out, cfg = _smk.input, _smk.output, _smk.params.config
+results = results_dir(_smk)
 data = {n: xr.load_dataset(getattr(inp, n)) for n in ("construction", "cuts", "ensemble", "tolerance", "exact")}
 r = pp.PileRun(data["construction"], data["cuts"], data["ensemble"], data["exact"], cfg)
 save(pp.figure(r), out, dpi=130, show=True)
@@ -64,7 +66,7 @@ write_finding(out, pp.finding(r))
 #
 # 1. *Construction* (`construction.nc`): polydisperse discs (radii uniform in
 #    $[0.8, 1.2]$ mm) are poured from a row of insertion sites above $x = 0$
-#    onto a rough ground (a row of touching fixed discs), with friction 0.5
+#    onto a rough ground (a row of touching fixed discs), with friction $\mu = 0.5$
 #    everywhere and no restitution. Every step is a Moreau–Jean step with
 #    warm-started NLGS; a batch of grains is inserted at the free sites every few
 #    steps. The source stays a fixed drop height above the settled grains under
@@ -73,7 +75,7 @@ write_finding(out, pp.finding(r))
 #    (one step from $u_i = 0$, warm guess) gives $u_f = 0$ within $10^{-6}\,g h$.
 #    Its forces $r = s/h$ are the *history* forces.
 # 2. *Free surface* (`cuts.nc`): the highest disc top per one-diameter bin, and
-#    a straight line fitted to each flank between 20 % and 80 % of the apex
+#    a straight line fitted to each flank between $20\,\%$ and $80\,\%$ of the apex
 #    height: the angle of repose.
 # 3. *Cut resultant*: for a vertical cut at $x_c$, the sum of the forces exerted
 #    by the grains with centres on the axis side upon the grains with centres on
@@ -115,11 +117,23 @@ display(Markdown(pp.construction_text(r)))
 # %%
 display(Markdown(pp.arching_text(r)))
 
+# %%
+display(Markdown(claim_markdown("s5-parallel-to-surface", results, "fig4_pile")))
+
+# %%
+display(Markdown(claim_markdown("s5-ten-contacts", results, "fig4_pile")))
+
 # %% [markdown]
 # ## The indetermination cloud of the default cut
 
 # %%
 display(Markdown(pp.cloud_text(r) + "\n\n" + pp.tolerance_text(r, data["tolerance"])))
+
+# %%
+display(Markdown(claim_markdown("s5-cloud", results, "fig4_pile")))
+
+# %%
+display(Markdown(claim_markdown("s5-cut-position", results, "fig4_pile")))
 
 # %% [markdown]
 # ## The exact set of the final state
@@ -136,8 +150,14 @@ display(Markdown(pp.cloud_text(r) + "\n\n" + pp.tolerance_text(r, data["toleranc
 # %%
 display(Markdown(pp.exact_text(data["exact"], data["ensemble"], data["cuts"])))
 
+# %%
+display(Markdown(claim_markdown("s5-geometry-enough", results, "fig4_pile")))
+
+# %%
+display(Markdown(claim_markdown("s6-reassuring", results, "fig4_pile")))
+
 # %% [markdown]
-# ## Ground pressure (beyond the paper)
+# ## Ground pressure
 #
 # The paper quotes measurements in which the ground pressure "does not relate to the
 # height of material above", possibly with a minimum under the apex. The dip depth is
@@ -147,6 +167,12 @@ display(Markdown(pp.exact_text(data["exact"], data["ensemble"], data["cuts"])))
 
 # %%
 display(Markdown(pp.pressure_text(r) + "\n\n" + pp.dip_sentence(data["exact"])))
+
+# %%
+display(Markdown(claim_markdown("s5-pressure-not-height", results, "fig4_pile")))
+
+# %%
+display(Markdown(claim_markdown("s5-dip", results, "fig4_pile")))
 
 # %% [markdown]
 # ## Where the reproduction differs

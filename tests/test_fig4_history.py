@@ -380,3 +380,34 @@ def test_size_comparison_sees_a_shift_and_not_a_null(analysis):
     np.testing.assert_allclose(shifted.dip_size_diff.values[1], 0.0, atol=0)
     with pytest.raises(ValueError, match="at least 2"):
         hsz.size_dataset([analysis])
+
+
+def test_page_figure_and_sentences(analysis, piles, results):
+    """The page's figure: lettered panels, no overlapping texts, fonts of at least 9 pt; its
+    sentences carry the dips of the mean profiles and name every dip outside its band."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from ncd.figures import history_plots as hp
+    from ncd.pages.notebook import MIN_FONT_PT, text_layout
+
+    first = {ds.attrs["history"]: ds for ds in piles if ds.attrs["member"] == 0}
+    fig = hp.figure(analysis, [first["point"], first["rain"]])
+    assert [ax.get_title(loc="left")[:3] for ax in fig.axes] == ["(a)", "(b)", "(c)", "(d)"]
+    lay = text_layout(fig)
+    assert lay["overlaps"] == [] and lay["min_font_pt"] >= MIN_FONT_PT
+    plt.close(fig)
+    k0 = analysis.kernel.values[0]
+    text = hp.stress_text(analysis)
+    for h, name in (("point", "point source"), ("rain", "rain")):
+        assert f"{name} {float(analysis.dip_mean.sel(history=h, kernel=k0)):.3f}" in text
+    out = hp.outside_band(analysis)
+    assert (hp.outside_text(analysis) == "") == (out == [])
+    for h, k, m, lo, hi in out:
+        assert not lo <= m <= hi and f"kernel {k:g} d: {m:.3f}" in hp.outside_text(analysis)
+    cfg = yaml.safe_load(first["point"].attrs["config_yaml"]) if "config_yaml" in first["point"].attrs else None
+    texts = [text, hp.experiments_text(analysis), hp.arching_text(analysis), hp.exact_text(analysis),
+             hp.finding(analysis)] + ([hp.shapes_text(analysis, cfg)] if cfg and "source" in cfg else [])
+    assert not [t for t in texts if "nan" in t.lower()]

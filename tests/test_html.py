@@ -2,6 +2,9 @@
 folded, maths typeset offline, every figure shown.  ``slow`` tests open the pages in
 Debian's headless chromium (skipped without it) and keep screenshots under
 ``results/screenshots/``."""
+import base64
+import io
+import json
 import re
 import shutil
 import subprocess
@@ -169,10 +172,6 @@ def probed_dom(page, tmp_path):
 
 def figure_layouts(dom):
     """(rendered / natural width, text layout) of every PNG of the page saved by ncd.pages.notebook.save."""
-    import base64
-    import io
-    import json
-
     from PIL import Image
 
     from ncd.pages.notebook import LAYOUT_KEY
@@ -288,5 +287,27 @@ def test_report_captions_include_the_finding(tmp_path, monkeypatch):
             assert inc == f"results/figures/{rst.stem}.finding.rst", inc
             (tmp_path / inc).parent.mkdir(parents=True, exist_ok=True)
             (tmp_path / inc).write_text(f"Measured for {rst.stem}: 0.123 N.\n")
-            html = publish_parts(text, writer_name="html")["body"]
+            html = publish_parts(text, writer="html")["body"]
             assert f"Measured for {rst.stem}: 0.123 N." in html
+
+
+def test_save_records_the_layout_in_the_png(tmp_path):
+    """The PNG written by ``save`` carries its text layout at the saved dpi; the figure keeps its
+    own dpi for the notebook's display."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from PIL import Image
+
+    from ncd.pages.notebook import LAYOUT_KEY, save
+
+    fig, ax = plt.subplots(figsize=(4, 3), dpi=72)
+    ax.set_title("(a) a title")
+    ax.set_xlabel("x", fontsize=11)
+    out = type("Out", (), {"png": str(tmp_path / "f.png"), "pdf": str(tmp_path / "f.pdf")})()
+    save(fig, out, dpi=150)
+    lay = json.loads(Image.open(out.png).text[LAYOUT_KEY])
+    assert lay["dpi"] == 150 and lay["overlaps"] == [] and lay["width_in"] == 4 and fig.dpi == 72
+    assert lay["min_font_pt"] == min(11, ax.xaxis.get_ticklabels()[0].get_fontsize())
+    plt.close(fig)

@@ -134,8 +134,10 @@ def save(fig, output, dpi=130, show=False, **kwargs):
     reruns give the same bytes); ``show`` also displays the PNG in the notebook.  The PNG
     carries :func:`text_layout` at the saved dpi (text chunk :data:`LAYOUT_KEY`)."""
     Path(output.png).parent.mkdir(parents=True, exist_ok=True)
+    shown_dpi = fig.dpi                  # measured at the saved dpi, then displayed as before
     fig.set_dpi(dpi)
     layout = json.dumps(text_layout(fig), ensure_ascii=True)
+    fig.set_dpi(shown_dpi)
     fig.savefig(output.png, dpi=dpi, metadata={LAYOUT_KEY: layout}, **kwargs)
     fig.savefig(output.pdf, metadata={"CreationDate": None}, **kwargs)
     if show:

@@ -13,6 +13,7 @@ next pages and the paper (:func:`nav_header`).
 """
 import re
 import shutil
+from html import escape
 from pathlib import Path
 
 import nbformat
@@ -26,8 +27,8 @@ TITLES = {
     "fig2_slope": "Figure 2 — dispersion of a grain's acceleration in a flow down a slope",
     "fig3_equilibrium": "Figure 3 — indetermination clouds of discs at rest",
     "fig4_pile": "Figure 4 — a pile poured from a localized source",
-    "fig4_history": "Figure 4, history as statistics — piles from a point source and from a rain",
-    "fig4_history_size": "Figure 4, history against size — piles of 10³ and 10⁴ grains",
+    "fig4_history": "Beyond the paper — Figure 4's piles from a point source and from a rain",
+    "fig4_history_size": "Beyond the paper — Figure 4's piles against their size",
     "fig5_governing": "Beyond the paper — governing parameters of indeterminacy",
     "stability": "Beyond the paper — stability on stiff and extreme cases",
     "error_vs_runtime": "Beyond the paper — error against run time",
@@ -123,8 +124,6 @@ def neighbours(name, pages):
 
 def nav_header(name, pages):
     """The ``<nav>`` opening a page: the index, the previous and next pages, the paper on HAL."""
-    from html import escape
-
     prev, nxt = neighbours(name, pages)
 
     def link(page, arrow):
