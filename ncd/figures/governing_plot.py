@@ -7,13 +7,14 @@ the data (below each panel), panel letters are unique.
 import matplotlib.pyplot as plt
 import numpy as np
 
-from ncd.figures.governing import eta_table
+from ncd.figures.governing import eta_table, mixed_only
 from ncd.figures.governing_summary import factor_table, line_counts
 from ncd.figures.governing_unger import eta_curve
 
 UNGER_PEAK_MU = 0.1     # Unger, Kertész & Wolf (2005): eta peaks near mu = 0.1, eta ∝ mu below
 TITLE = "Beyond the paper: governing parameters of indeterminacy"
-SERIES = {"eta_walk": ("η_U, their random walk", "C0", "o"), "eta_uniform": ("η_U, uniform sample", "C1", "s"),
+SERIES = {"eta_walk": ("η_U, their random walk", "C0", "o"),
+          "eta_uniform": ("η_U, uniform sample (chains agree)", "C1", "s"),
           "eta_exact": ("exact range ratio (not η_U)", "0.45", "^")}
 
 
@@ -81,7 +82,7 @@ def panel_convergence(ax, ds, letter):
 def panel_centrality(ax, ds, letter):
     """Distance to the centre of A ∩ C (RMS per contact / <|F|>): history state, walk samples,
     uniform samples, per packing against mu (plates)."""
-    sel = (ds.kind.values == 0) & np.isfinite(ds.history_distance.values)
+    sel = (ds.kind.values == 0) & np.isfinite(ds.history_distance.values) & (ds.dim_AC_rank.values > 0)
     for var, label, color, marker in (("history_distance", "history (built) state", "C3", "o"),
                                       ("walk_distance", "random-walk samples (mean)", "C0", "x"),
                                       ("uniform_distance", "uniform samples (mean)", "C1", "s")):
@@ -108,6 +109,8 @@ def panel_flows(ax, flows, factor, letter):
     ax.plot(u[:, 0], u[:, 1], "x:", color="0.5", label="unknown (unconverged)")
     ax.set(xscale=scale, xlabel=label, ylabel="fraction of scanned steps", ylim=(-0.02, 1.02),
            title=f"({letter}) flows against {label.split()[0]}")
+    ax.set_xticks(t[:, 0], [f"{v:g}" for v in t[:, 0]])         # the settings only: no crowded minor labels
+    ax.xaxis.set_minor_formatter(plt.NullFormatter())
     base = {"mu": flows.mu, "h": flows.h, "slope": flows.slope_deg}[factor].values[flows.factor.values == 0]
     if len(base):
         ax.axvline(base[0], color="k", lw=0.8, ls=":", label="Figure 2's setting")
@@ -140,6 +143,7 @@ def panel_line(ax, flows, letter):
 
 def figure(ds, flows=None):
     """The whole figure: packings (a-f) and, with ``flows``, the flow study (g-j)."""
+    ds = mixed_only(ds)           # the uniform sample's measures where its two chains agree
     fig = plt.figure(figsize=(17, 15 if flows is not None else 10), layout="constrained")
     subs = fig.subfigures(2 if flows is not None else 1, 1, height_ratios=[2, 1] if flows is not None else None,
                           squeeze=False)[:, 0]
