@@ -267,8 +267,8 @@ def analyse(builds, j, cfg, mu, rng_walk, rng_of):
     walk = random_walk(sl, cfg["walk"], rng_walk)
     out.update(walk)
     out["eta_walk"] = eta_u(walk["samples"][walk["ok"]]) if walk["ok"].sum() > 1 else np.nan
-    if out["dim_AC_rank"] == 0:      # one point: the walk's spread is round-off (~1e-12), eta_U is 0
-        out["eta_walk"] = 0.0
+    if out["dim_AC_rank"] == 0:      # one point: the walk's spread and the LP widths are round-off
+        out["eta_walk"] = out["eta_exact"] = 0.0
     uni = uniform_sample(sl, out, cfg["uniform"], rng_of, e["feas_tol"]) if out["bounded"] else None
     out["uniform"] = uni
     if uni is not None:

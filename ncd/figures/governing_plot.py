@@ -22,28 +22,40 @@ def _legend(ax, ncol=1):
     ax.legend(fontsize=9, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=ncol, frameon=False)
 
 
+def _log_or_empty(ax, has_data, axes="xy"):
+    """Log scales when there is something positive to draw, else one sentence (a run where
+    every slice is determinate has no positive eta to put on a log axis)."""
+    if has_data:
+        for a in axes:
+            getattr(ax, f"set_{a}scale")("log")
+    else:
+        ax.text(0.5, 0.5, "no non-zero value in this run", transform=ax.transAxes, ha="center", fontsize=10)
+
+
 def _band(ax, table, label, color, marker="o", ls="-"):
     ok = np.isfinite(table[:, 1]) & (table[:, 1] > 0)
     t = table[ok]
     if not len(t):
-        return
+        return False
     ax.plot(t[:, 0], t[:, 1], marker=marker, color=color, ls=ls, label=label)
     half = np.nan_to_num(t[:, 2])
     ax.fill_between(t[:, 0], np.maximum(t[:, 1] - half, 0.2 * t[:, 1]), t[:, 1] + half, color=color, alpha=0.2,
                     lw=0)
+    return True
 
 
 def panel_eta(ax, ds, kind, letter, title):
     """eta_U (walk and uniform) and the exact range ratio against mu, 95 % bands over packings."""
-    for var, (label, color, marker) in SERIES.items():
-        _band(ax, eta_table(ds, var, kind), label, color, marker)
+    drawn = [_band(ax, eta_table(ds, var, kind), label, color, marker) for var, (label, color, marker)
+             in SERIES.items()]
     ax.axvline(UNGER_PEAK_MU, color="k", ls=":", lw=1, label="Unger et al.: peak near μ = 0.1")
     t = eta_table(ds, "eta_walk", kind)
     ok = np.isfinite(t[:, 1]) & (t[:, 1] > 0)
     if ok.sum() > 1:                               # slope-1 guide through the smallest mu with data
         i = int(np.argmax(ok))
         ax.plot(t[i:i + 3, 0], t[i, 1] * t[i:i + 3, 0] / t[i, 0], "k--", lw=1, label="∝ μ (Unger et al.)")
-    ax.set(xscale="log", yscale="log", xlabel="μ", ylabel="η", title=f"({letter}) {title}")
+    ax.set(xlabel="μ", ylabel="η", title=f"({letter}) {title}")
+    _log_or_empty(ax, any(drawn))
     _legend(ax)
 
 
@@ -89,8 +101,8 @@ def panel_centrality(ax, ds, letter):
         v = ds[var].values[sel]
         pos = v > 0
         ax.plot(ds.mu.values[sel][pos], v[pos], marker, color=color, ls="none", label=label, mfc="none")
-    ax.set(xscale="log", yscale="log", xlabel="μ", ylabel="distance to the centre / ⟨|F|⟩",
-           title=f"({letter}) centrality of the history state")
+    ax.set(xlabel="μ", ylabel="distance to the centre / ⟨|F|⟩", title=f"({letter}) centrality of the history state")
+    _log_or_empty(ax, bool(sel.any()))
     _legend(ax)
 
 
@@ -159,6 +171,9 @@ def figure(ds, flows=None):
         for ax, factor, letter in zip(bottom[:3], ("mu", "h", "slope"), "ghi"):
             panel_flows(ax, flows, factor, letter)
         panel_line(bottom[3], flows, "j")
+    for ax in fig.axes:             # log axes: labelled decades only (minor labels collide)
+        if ax.get_xscale() == "log":
+            ax.xaxis.set_minor_formatter(plt.NullFormatter())
     fig.suptitle(TITLE, fontsize=14)
     return fig
 
@@ -174,8 +189,9 @@ def panel_walk_vs_uniform(ax, ds, letter):
     if len(v):
         lim = [v.min() * 0.8, v.max() * 1.25]
         ax.plot(lim, lim, "k:", lw=1, label="equal")
-    ax.set(xscale="log", yscale="log", xlabel="η_U, uniform sample", ylabel="η_U, random walk",
+    ax.set(xlabel="η_U, uniform sample", ylabel="η_U, random walk",
            title=f"({letter}) walk against uniform (colour: log10 μ)")
+    _log_or_empty(ax, bool(len(v)))
     _legend(ax, ncol=1)
 
 

@@ -88,8 +88,9 @@ def uniform_sample(sl, exact, u, rng_of, feas_tol=1e-10):
     stretch[:, 1] = np.where(sl.mu > 0, sl.mu, 1.0)
     H = sl.H @ sp.diags(stretch.ravel())
     P = ForcePolytope(H, sl.F, np.where(sl.mu > 0, 1.0, 0.0), feas_tol)
-    x, info = P.uniform_samples(rng_of, 2, u["per_chain"], rounds=u["rounds"], implicit=exact["implicit"],
-                                dispersed=True)
+    d = max(int(exact["dim_AC_rank"]), 1)
+    x, info = P.uniform_samples(rng_of, 2, u["per_chain"], thin=u.get("thin", 4) * d, rounds=u["rounds"],
+                                implicit=exact["implicit"], dispersed=True)
     x = x.reshape(2, u["per_chain"], k, 2) * stretch
     etas = [eta_u(c) for c in x]
     eta = eta_u(x.reshape(-1, k, 2))
