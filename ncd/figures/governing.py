@@ -25,6 +25,7 @@ from ncd.core.contacts import h_matrix
 from ncd.core.errors import InputError
 from ncd.core.scene import make_scene
 from ncd.dynamics.explore import member_rng, shard_members
+from ncd.exact.exact_set import ExactSet
 from ncd.exact.polytope import ForcePolytope
 from ncd.figures.governing_exact import exact_measures
 from ncd.figures.governing_unger import centrality, eta_u, random_walk, uniform_sample
@@ -215,6 +216,10 @@ def cell_of(builds, j, cfg, mu):
         raise ValueError(f"build {int(builds.build[j])}: the contacts found again differ from those stored")
     k = len(keys)
     f = np.column_stack([builds.rest_force_n[j].values[:k], builds.rest_force_t[j].values[:k]])
+    # the rest test's forces (|H r + F| up to ~1e-9 of the load) made exact on their active
+    # Coulomb rows at the build's friction: the slice's loads are then consistent to round-off
+    mu_b = np.where(contacts.body_b == cell.n, 0.0, float(builds.build_mu[j]))
+    f = ExactSet(h_matrix(cell.scene, contacts), plates.external_force(cell), mu_b).refine(f.ravel()).reshape(k, 2)
     if mu == 0.0 or float(builds.build_mu[j]) != mu:
         contacts.mu[:] = np.where(contacts.body_b == cell.n, 0.0, float(mu))    # plate contacts stay frictionless
     return cell, contacts, f
@@ -262,6 +267,8 @@ def analyse(builds, j, cfg, mu, rng_walk, rng_of):
     walk = random_walk(sl, cfg["walk"], rng_walk)
     out.update(walk)
     out["eta_walk"] = eta_u(walk["samples"][walk["ok"]]) if walk["ok"].sum() > 1 else np.nan
+    if out["dim_AC_rank"] == 0:      # one point: the walk's spread and the LP widths are round-off
+        out["eta_walk"] = out["eta_exact"] = 0.0
     uni = uniform_sample(sl, out, cfg["uniform"], rng_of, e["feas_tol"]) if out["bounded"] else None
     out["uniform"] = uni
     if uni is not None:
@@ -288,7 +295,9 @@ SCALARS = {"n_contacts": "contacts kappa in the slice", "rank_H": "rank of the s
            "dim_uniform": "dimension of the hit-and-run space", "history_rank": "fraction of uniform samples "
            "closer to the centre than the history state", "history_distance": "|history - centre| / <|F|>",
            "walk_distance": "mean |walk sample - centre| / <|F|>", "uniform_distance": "mean |uniform sample - "
-           "centre| / <|F|>", "walk_ok": "random-walk samples that are points of A ∩ C"}
+           "centre| / <|F|>", "walk_ok": "random-walk samples that are points of A ∩ C",
+           "mixed": "1: the two uniform chains agree (eta_U gap <= 0.3, R-hat <= 1.2)"}
+MIXED_GAP, MIXED_RHAT = 0.3, 1.2
 
 
 def analysis_shard(builds, cfg, shard, n_shards, progress=None):
@@ -328,10 +337,11 @@ def _dataset(rows, table, sel, builds, cfg):
         if u is not None:
             umean[j, :, :k], ustd[j, :, :k] = u["chain_mean"], u["chain_std"]
             r.update(eta_uniform=u["eta"], eta_uniform_gap=u["gap"], rhat=u["rhat"], dim_uniform=u["dimension"],
-                     **r["centrality"])
+                     mixed=float(u["gap"] <= MIXED_GAP and u["rhat"] <= MIXED_RHAT), **r["centrality"])
         r["walk_ok"] = int(r["ok"].sum())
+        r.setdefault("mixed", 0.0)
     scal = {q: np.array([r.get(q, np.nan) for r in rows], float) for q in SCALARS}
-    for q in ("bounded", "bounded_cell"):
+    for q in ("bounded", "bounded_cell", "mixed"):
         scal[q] = scal[q].astype(np.int8)
     data = {q: _var("packing", v, "N" if q == "scale" else "1", SCALARS[q]) for q, v in scal.items()}
     b = table["build"][sel]
@@ -374,6 +384,14 @@ def builds_of(paths):
     return merge_shards(paths, dim="build")
 
 
+def mixed_only(ds):
+    """``ds`` with the uniform sample's measures NaN where its two chains disagree (not mixed)."""
+    ds = ds.copy()
+    for q in ("eta_uniform", "history_distance", "uniform_distance", "walk_distance", "history_rank"):
+        ds[q] = ds[q].where(ds.mixed == 1)
+    return ds
+
+
 def eta_table(ds, var="eta_walk", kind=0):
     """Per mu: mean, 95 % band (t-interval over packings), count of ``var`` for ``kind``."""
     sel = ds.kind.values == kind
@@ -389,4 +407,4 @@ def eta_table(ds, var="eta_walk", kind=0):
 
 __all__ = ["KINDS", "mu_values", "build_table", "analysis_table", "ballistic", "initial_cell", "build",
            "pack_shard", "cell_of", "slice_of", "coordination", "analyse", "plates_bounded", "analysis_shard",
-           "merge", "builds_of", "eta_table", "SCALARS"]
+           "merge", "builds_of", "mixed_only", "eta_table", "SCALARS", "MIXED_GAP", "MIXED_RHAT"]

@@ -15,7 +15,8 @@ import xarray as xr
 from scipy import stats
 
 from ncd.core.verdict import DIFFERS, NOT_COMPUTED, REPRODUCED, Verdict
-from ncd.figures.governing import eta_table
+from ncd.figures.governing import eta_table, mixed_only
+from ncd.figures.governing_unger import eta_u
 
 DATA = "fig5_governing/packings.nc"
 PEAK_MU = 0.1              # Unger et al.: maximum near mu = 0.1
@@ -68,8 +69,8 @@ def control_trend(ds, var="eta_walk"):
     return float(stats.spearmanr(t[:, 0], t[:, 1])[0]), int((np.diff(t[:, 1]) < 0).sum())
 
 
-def centrality_summary(ds, kind=None):
-    """Over packings with a uniform sample and dim(A ∩ C) > 0: how many, in how many the
+def centrality_summary(ds, kind=0):
+    """Over packings with a uniform sample that mixed and dim(A ∩ C) > 0 (series ``kind``): how many, in how many the
     history state is closer to the centre than the mean uniform sample, and the median
     fraction of uniform samples closer than it."""
     sel = np.isfinite(ds.history_distance.values) & (ds.dim_AC_rank.values > 0)
@@ -80,9 +81,22 @@ def centrality_summary(ds, kind=None):
     return int(sel.sum()), int(closer.sum()), float(np.median(rank)) if sel.any() else np.nan
 
 
+def walk_settling(ds):
+    """Per analysis with eta_U > 0 on the walk: |eta_U over the first half of the accepted
+    samples / eta_U over all - 1|; returns (median, largest, count)."""
+    out = []
+    for j in np.nonzero(np.nan_to_num(ds.eta_walk.values) > 0)[0]:
+        ok = ds.walk_point.values[j] == 1
+        k = int(ds.n_contacts[j])
+        f = np.stack([ds.walk_n.values[j][ok][:, :k], ds.walk_t.values[j][ok][:, :k]], axis=-1)
+        if len(f) >= 6:
+            out.append(abs(eta_u(f[: len(f) // 2]) / eta_u(f) - 1.0))
+    return (float(np.median(out)), float(np.max(out)), len(out)) if out else (np.nan, np.nan, 0)
+
+
 def _open(results):
     path = Path(results) / DATA
-    return xr.load_dataset(path) if path.exists() else None
+    return mixed_only(xr.load_dataset(path)) if path.exists() else None
 
 
 def _missing():
@@ -150,5 +164,5 @@ def claim_unger_centrality(results):
                    "unger-centrality", (DATA,))
 
 
-__all__ = ["peak", "small_mu_slope", "vanishing", "control_trend", "centrality_summary", "claim_unger_peak",
+__all__ = ["walk_settling", "peak", "small_mu_slope", "vanishing", "control_trend", "centrality_summary", "claim_unger_peak",
            "claim_unger_vanishes", "claim_unger_control", "claim_unger_centrality", "PEAK_MU", "Z_ISOSTATIC"]

@@ -7,13 +7,14 @@ the data (below each panel), panel letters are unique.
 import matplotlib.pyplot as plt
 import numpy as np
 
-from ncd.figures.governing import eta_table
+from ncd.figures.governing import eta_table, mixed_only
 from ncd.figures.governing_summary import factor_table, line_counts
 from ncd.figures.governing_unger import eta_curve
 
 UNGER_PEAK_MU = 0.1     # Unger, Kertész & Wolf (2005): eta peaks near mu = 0.1, eta ∝ mu below
 TITLE = "Beyond the paper: governing parameters of indeterminacy"
-SERIES = {"eta_walk": ("η_U, their random walk", "C0", "o"), "eta_uniform": ("η_U, uniform sample", "C1", "s"),
+SERIES = {"eta_walk": ("η_U, their random walk", "C0", "o"),
+          "eta_uniform": ("η_U, uniform sample (chains agree)", "C1", "s"),
           "eta_exact": ("exact range ratio (not η_U)", "0.45", "^")}
 
 
@@ -21,28 +22,40 @@ def _legend(ax, ncol=1):
     ax.legend(fontsize=9, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=ncol, frameon=False)
 
 
+def _log_or_empty(ax, has_data, axes="xy"):
+    """Log scales when there is something positive to draw, else one sentence (a run where
+    every slice is determinate has no positive eta to put on a log axis)."""
+    if has_data:
+        for a in axes:
+            getattr(ax, f"set_{a}scale")("log")
+    else:
+        ax.text(0.5, 0.5, "no non-zero value in this run", transform=ax.transAxes, ha="center", fontsize=10)
+
+
 def _band(ax, table, label, color, marker="o", ls="-"):
     ok = np.isfinite(table[:, 1]) & (table[:, 1] > 0)
     t = table[ok]
     if not len(t):
-        return
+        return False
     ax.plot(t[:, 0], t[:, 1], marker=marker, color=color, ls=ls, label=label)
     half = np.nan_to_num(t[:, 2])
     ax.fill_between(t[:, 0], np.maximum(t[:, 1] - half, 0.2 * t[:, 1]), t[:, 1] + half, color=color, alpha=0.2,
                     lw=0)
+    return True
 
 
 def panel_eta(ax, ds, kind, letter, title):
     """eta_U (walk and uniform) and the exact range ratio against mu, 95 % bands over packings."""
-    for var, (label, color, marker) in SERIES.items():
-        _band(ax, eta_table(ds, var, kind), label, color, marker)
+    drawn = [_band(ax, eta_table(ds, var, kind), label, color, marker) for var, (label, color, marker)
+             in SERIES.items()]
     ax.axvline(UNGER_PEAK_MU, color="k", ls=":", lw=1, label="Unger et al.: peak near μ = 0.1")
     t = eta_table(ds, "eta_walk", kind)
     ok = np.isfinite(t[:, 1]) & (t[:, 1] > 0)
     if ok.sum() > 1:                               # slope-1 guide through the smallest mu with data
         i = int(np.argmax(ok))
         ax.plot(t[i:i + 3, 0], t[i, 1] * t[i:i + 3, 0] / t[i, 0], "k--", lw=1, label="∝ μ (Unger et al.)")
-    ax.set(xscale="log", yscale="log", xlabel="μ", ylabel="η", title=f"({letter}) {title}")
+    ax.set(xlabel="μ", ylabel="η", title=f"({letter}) {title}")
+    _log_or_empty(ax, any(drawn))
     _legend(ax)
 
 
@@ -81,15 +94,15 @@ def panel_convergence(ax, ds, letter):
 def panel_centrality(ax, ds, letter):
     """Distance to the centre of A ∩ C (RMS per contact / <|F|>): history state, walk samples,
     uniform samples, per packing against mu (plates)."""
-    sel = (ds.kind.values == 0) & np.isfinite(ds.history_distance.values)
+    sel = (ds.kind.values == 0) & np.isfinite(ds.history_distance.values) & (ds.dim_AC_rank.values > 0)
     for var, label, color, marker in (("history_distance", "history (built) state", "C3", "o"),
                                       ("walk_distance", "random-walk samples (mean)", "C0", "x"),
                                       ("uniform_distance", "uniform samples (mean)", "C1", "s")):
         v = ds[var].values[sel]
         pos = v > 0
         ax.plot(ds.mu.values[sel][pos], v[pos], marker, color=color, ls="none", label=label, mfc="none")
-    ax.set(xscale="log", yscale="log", xlabel="μ", ylabel="distance to the centre / ⟨|F|⟩",
-           title=f"({letter}) centrality of the history state")
+    ax.set(xlabel="μ", ylabel="distance to the centre / ⟨|F|⟩", title=f"({letter}) centrality of the history state")
+    _log_or_empty(ax, bool(sel.any()))
     _legend(ax)
 
 
@@ -108,6 +121,8 @@ def panel_flows(ax, flows, factor, letter):
     ax.plot(u[:, 0], u[:, 1], "x:", color="0.5", label="unknown (unconverged)")
     ax.set(xscale=scale, xlabel=label, ylabel="fraction of scanned steps", ylim=(-0.02, 1.02),
            title=f"({letter}) flows against {label.split()[0]}")
+    ax.set_xticks(t[:, 0], [f"{v:g}" for v in t[:, 0]])         # the settings only: no crowded minor labels
+    ax.xaxis.set_minor_formatter(plt.NullFormatter())
     base = {"mu": flows.mu, "h": flows.h, "slope": flows.slope_deg}[factor].values[flows.factor.values == 0]
     if len(base):
         ax.axvline(base[0], color="k", lw=0.8, ls=":", label="Figure 2's setting")
@@ -140,6 +155,7 @@ def panel_line(ax, flows, letter):
 
 def figure(ds, flows=None):
     """The whole figure: packings (a-f) and, with ``flows``, the flow study (g-j)."""
+    ds = mixed_only(ds)           # the uniform sample's measures where its two chains agree
     fig = plt.figure(figsize=(17, 15 if flows is not None else 10), layout="constrained")
     subs = fig.subfigures(2 if flows is not None else 1, 1, height_ratios=[2, 1] if flows is not None else None,
                           squeeze=False)[:, 0]
@@ -155,6 +171,9 @@ def figure(ds, flows=None):
         for ax, factor, letter in zip(bottom[:3], ("mu", "h", "slope"), "ghi"):
             panel_flows(ax, flows, factor, letter)
         panel_line(bottom[3], flows, "j")
+    for ax in fig.axes:             # log axes: labelled decades only (minor labels collide)
+        if ax.get_xscale() == "log":
+            ax.xaxis.set_minor_formatter(plt.NullFormatter())
     fig.suptitle(TITLE, fontsize=14)
     return fig
 
@@ -170,8 +189,9 @@ def panel_walk_vs_uniform(ax, ds, letter):
     if len(v):
         lim = [v.min() * 0.8, v.max() * 1.25]
         ax.plot(lim, lim, "k:", lw=1, label="equal")
-    ax.set(xscale="log", yscale="log", xlabel="η_U, uniform sample", ylabel="η_U, random walk",
+    ax.set(xlabel="η_U, uniform sample", ylabel="η_U, random walk",
            title=f"({letter}) walk against uniform (colour: log10 μ)")
+    _log_or_empty(ax, bool(len(v)))
     _legend(ax, ncol=1)
 
 

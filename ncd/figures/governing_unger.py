@@ -19,6 +19,7 @@ samples of the same set ``A ∩ C`` of a slice (:mod:`ncd.scenes.plates`):
 the centre of the set than random samples do.
 """
 import numpy as np
+import scipy.sparse as sp
 
 from ncd.exact.polytope import ForcePolytope
 from ncd.scenes.plates import relax
@@ -79,11 +80,18 @@ def uniform_sample(sl, exact, u, rng_of, feas_tol=1e-10):
     equalities).  Returns the pooled samples (2 per_chain, kappa, 2), per-chain means and
     standard deviations (2, kappa, 2), ``eta`` (pooled), ``gap`` (|eta_1 - eta_2| / eta),
     ``rhat`` and the dimension."""
-    P = ForcePolytope(sl.H, sl.F, sl.mu, feas_tol)
-    k = P.n_contacts
-    x, info = P.uniform_samples(rng_of, 2, u["per_chain"], rounds=u["rounds"], implicit=exact["implicit"],
-                                dispersed=True)
-    x = x.reshape(2, u["per_chain"], k, 2)
+    # sampled in r' = (r_n, r_t / mu): the Coulomb sectors become right angles, the thin
+    # tangential directions of small mu as wide as the normal ones (a linear map: uniform
+    # in r' is uniform in r), and the implicit rows are the same rows
+    k = len(sl.mu)
+    stretch = np.ones((k, 2))
+    stretch[:, 1] = np.where(sl.mu > 0, sl.mu, 1.0)
+    H = sl.H @ sp.diags(stretch.ravel())
+    P = ForcePolytope(H, sl.F, np.where(sl.mu > 0, 1.0, 0.0), feas_tol)
+    d = max(int(exact["dim_AC_rank"]), 1)
+    x, info = P.uniform_samples(rng_of, 2, u["per_chain"], thin=u.get("thin", 4) * d, rounds=u["rounds"],
+                                implicit=exact["implicit"], dispersed=True)
+    x = x.reshape(2, u["per_chain"], k, 2) * stretch
     etas = [eta_u(c) for c in x]
     eta = eta_u(x.reshape(-1, k, 2))
     gap = abs(etas[0] - etas[1]) / eta if eta > 0 else 0.0
