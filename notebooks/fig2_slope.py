@@ -168,6 +168,9 @@ ax[1].invert_xaxis()
 ax[1].legend(fontsize=8)
 fig.tight_layout()
 
+# %%
+Markdown(sa.warm_check(ens, cfg["analysis"]["solution_threshold"]) or "The warm runs are plain NLGS.")
+
 # %% [markdown]
 # ## True indeterminacy or iteration error? Spread against tolerance
 #

@@ -315,6 +315,30 @@ def test_the_restart_reproduces_the_trajectory_step(data):
     np.testing.assert_allclose(acc[:, 1], traj.reference_accel_y, rtol=0, atol=1e-9)
 
 
+def test_warm_runs_with_local_exact_solves_land_on_plain_nlgs_solution(data):
+    """The warm runs use local exact solves; the first plain_check_runs members were also run by
+    plain NLGS, and both end points are the same solution (closer than the threshold that
+    tells two solutions apart) at every tolerance; the other members are not checked (NaN)."""
+    _, ens, _, cfg, an = data
+    ecfg = cfg["explore"]
+    assert int(ens.attrs["warm_local_exact"]) == int(ecfg["warm_local_exact"])
+    dist = ens.warm_plain_distance
+    checked = ens.run.values < ecfg["plain_check_runs"]
+    assert checked.any() and np.isnan(dist.values[:, ~checked]).all()
+    assert (dist.values[:, checked] <= an["analysis"]["solution_threshold"]).all()
+    text = sa.warm_check(ens, an["analysis"]["solution_threshold"])
+    assert f"{int(checked.sum())} of them" in text and "same solution" in text
+
+
+def test_warm_check_sentence_on_a_synthetic_ensemble():
+    ens = xr.Dataset({"warm_plain_distance": (("tol", "run"), [[1e-6, np.nan, 3e-5], [2e-7, np.nan, 4e-6]])},
+                     coords={"tol": [1e-6, 1e-8], "run": [0, 1, 2]}, attrs={"warm_local_exact": 1})
+    text = sa.warm_check(ens, 1e-3)
+    assert "2 of them" in text and "4.0e-06 |g|" in text and "same solution" in text
+    assert "different solutions" in sa.warm_check(ens, 1e-6)
+    assert sa.warm_check(ens.assign_attrs(warm_local_exact=0), 1e-3) is None
+
+
 def test_a_member_does_not_depend_on_its_shard(data):
     traj, ens, _, cfg, _ = data
     member = int(ens.run.values[-1])
