@@ -9,8 +9,14 @@ checked against its source without the run (tests/test_readme.py)."""
 import sys
 from pathlib import Path
 
-from ncd.studies.bench import (read_speed_csv, replace_speed_block, speed_block, speed_markdown, speed_rows,
-                               write_speed_csv)
+from ncd.studies.bench import (
+    read_speed_csv,
+    replace_speed_block,
+    speed_block,
+    speed_markdown,
+    speed_rows,
+    write_speed_csv,
+)
 
 ROOT = Path(__file__).resolve().parent.parent
 README, SOURCE = ROOT / "README.md", ROOT / "docs" / "speed.tsv"
