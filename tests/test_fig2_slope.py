@@ -384,3 +384,22 @@ def test_census_solutions_are_exact_and_contain_the_nlgs_end_points(data, result
             d = max(np.abs(cen.accel_x.values[i] - cen.accel_x.values[j]).max(),
                     np.abs(cen.accel_y.values[i] - cen.accel_y.values[j]).max())
             assert d > ccfg["same_tol"] * step.g
+
+
+def test_census_is_the_same_on_one_and_two_threads(data, results):
+    """The census runs its NLGS runs, Lemke runs, projections and restarts side by side on
+    the rule's threads, adding to the census in a fixed order: census.nc is the same
+    bit for bit whatever the thread count."""
+    import numba
+    traj, ens, meas, cfg, _ = data
+    ref = xr.load_dataset(results / "fig2_slope" / "census.nc")
+    cfg = {**cfg, "census": yaml.safe_load(ref.attrs["config_yaml"])}
+    before = numba.get_num_threads()
+    try:
+        for threads in (1, min(2, numba.config.NUMBA_NUM_THREADS)):
+            numba.set_num_threads(threads)
+            ds = census.census_dataset(traj, ens, meas, cfg)
+            for v in ref.data_vars:
+                np.testing.assert_array_equal(ds[v].values, ref[v].values, err_msg=f"{v}, {threads} threads")
+    finally:
+        numba.set_num_threads(before)
