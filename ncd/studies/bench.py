@@ -539,8 +539,9 @@ def dry_run(targets, config, cores=2, workdir="."):
     with tempfile.TemporaryDirectory() as tmp:
         cfg = Path(tmp) / "config.yaml"
         cfg.write_text(yaml.safe_dump(config, sort_keys=True))
-        cmd = [sys.executable, "-m", "snakemake", "-n", "--forceall", "--nolock", "--cores", str(cores),
-               "--configfile", str(cfg), *targets]
+        # the targets first: --configfile takes every argument after it
+        cmd = [sys.executable, "-m", "snakemake", *targets, "-n", "--forceall", "--nolock", "--cores", str(cores),
+               "--configfile", str(cfg)]
         out = subprocess.run(cmd, cwd=workdir, capture_output=True, text=True, check=True)
     return out.stdout + out.stderr
 
