@@ -190,7 +190,7 @@ def bench_results(results):
     d = results / "bench"
     if not (d / "core.nc").exists():
         pytest.skip(f"no benchmark results in {d} (run `snakemake -j2 bench`)")
-    return {k: xr.load_dataset(d / f"{k}.nc") for k in ("core", "sweeps", "ensemble", "peer", "rules")}
+    return {k: xr.load_dataset(d / f"{k}.nc") for k in ("core", "sweeps", "ensemble", "peer", "rules", "dag")}
 
 
 def test_bench_core_data(bench_results):
@@ -261,3 +261,19 @@ def test_power_law_recovers_an_exponent():
     p, c = bench.power_law(n, 2e-6 * n ** 1.25)
     assert abs(p - 1.25) < 1e-12 and abs(c / 2e-6 - 1) < 1e-9
     assert np.isnan(bench.power_law([1e3], [1.0])[0]) and np.isnan(bench.power_law([1, 2], [0.0, 1.0])[0])
+
+
+def test_bench_dag_has_every_job_and_a_critical_path(bench_results):
+    """dag.nc: every job of the default run with a benchmark file, CPU time at most wall
+    time x threads, and a critical path from a first job to the index, in order, whose
+    length is the sum of its jobs' times alone."""
+    dag = bench_results["dag"]
+    rules = bench_results["rules"]
+    assert dag.sizes["job"] >= rules.sizes["job"] and dag.attrs["dag_jobs"] > dag.sizes["job"]
+    assert (dag.cpu_s <= dag.wall_s * dag.threads + 1e-9).all()
+    np.testing.assert_allclose(dag.attrs["cpu_s"], float(dag.cpu_s.sum()))
+    path = dag.where(dag.critical == 1, drop=True).sortby("critical_order")
+    assert list(path.critical_order.values) == list(range(path.sizes["job"]))
+    assert path.rule.values[-1] == "index"
+    np.testing.assert_allclose(dag.attrs["critical_path_s"], float(path.alone_s.sum()), rtol=1e-9)
+    assert dag.attrs["ideal_s"] >= max(dag.attrs["critical_path_s"], dag.attrs["cpu_s"] / dag.attrs["cores"]) - 1e-9
