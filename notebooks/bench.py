@@ -43,7 +43,9 @@
 #   pymunk (Chipmunk2D, C, sequential impulses) with the same number of
 #   Gauss–Seidel iterations per step (`ncd.studies.peer`);
 # * `rules.nc`: the wall time of every rule of the figures' run, from Snakemake's
-#   `benchmark:` files.
+#   `benchmark:` files;
+# * `dag.nc`: the CPU time of every job of the default run and the critical path of its
+#   DAG (the job graph of a dry run, the times of the benchmark files).
 
 # %%
 import matplotlib
@@ -57,9 +59,10 @@ import matplotlib.pyplot as plt
 from IPython.display import Markdown, display
 
 from ncd.pages.notebook import paths, save
+from ncd.studies.bench import dag_summary, scaling_table
 
 # Snakemake's object, or by hand (from the repository or notebooks/) the files under results/
-snakemake = paths("bench", ["core", "sweeps", "tolerance", "tolerance_problems", "ensemble", "peer", "rules"], globals().get("snakemake"))
+snakemake = paths("bench", ["core", "sweeps", "tolerance", "tolerance_problems", "ensemble", "peer", "rules", "dag"], globals().get("snakemake"))
 
 core = xr.load_dataset(snakemake.input.core)
 sweeps = xr.load_dataset(snakemake.input.sweeps)
@@ -68,6 +71,7 @@ tol_pb = xr.load_dataset(snakemake.input.tolerance_problems)
 ens = xr.load_dataset(snakemake.input.ensemble)
 peer = xr.load_dataset(snakemake.input.peer)
 rules = xr.load_dataset(snakemake.input.rules)
+dag = xr.load_dataset(snakemake.input.dag)
 print(f"machine: {core.attrs['machine']}, {core.attrs['cpu_count']} cores; python {core.attrs['python']}, "
       f"numba {core.attrs['numba']}; load average at start {core.attrs['loadavg_start']:.2f}")
 
@@ -118,6 +122,20 @@ display(Markdown(
 tab["interleaved_gain"] = tab.ns_per_update / tab.ns_per_update_interleaved
 with pd.option_context("display.float_format", "{:.3g}".format):
     display(tab[["n_discs", "ns_per_update", "ns_per_update_interleaved", "interleaved_gain"]])
+
+# %% [markdown]
+# ## Time against N
+#
+# Building a packing (`ncd.studies.bench.dense_packing`: positions, radii, the scene's
+# checks), preparing a step (detection, Delassus blocks), one NLGS sweep and one
+# Moreau–Jean step (warm start, NLGS to the step tolerance within its sweep budget) at
+# each size, and the exponent $p$ of the least-squares fit $t = c\,N^p$ (log–log).
+
+# %%
+scaling = pd.DataFrame({name: times for name, times, _ in scaling_table(core)}, index=core.n_discs.values).T
+scaling["fitted p"] = [p for _, _, p in scaling_table(core)]
+with pd.option_context("display.float_format", "{:.3g}".format):
+    display(scaling.rename_axis("seconds at N ="))
 
 # %% [markdown]
 # ## Sweeps against N
@@ -250,6 +268,23 @@ with pd.option_context("display.max_rows", 200, "display.width", 200):
     display(per_figure.to_frame("seconds (sum of the figure's rules)"))
 display(Markdown(f"{len(rt)} jobs, {rt.seconds.sum() / 60:.1f} CPU-job minutes in all (with -j2 two "
                  "run at a time; the wall time of the whole run is in the README)."))
+
+# %% [markdown]
+# ## CPU time and critical path of the default run
+#
+# Every job of `snakemake -j2` (the job graph of a dry run), with its CPU time (user +
+# system) from its benchmark file and the time it would take alone on its threads (CPU
+# time over threads).  Snakemake counts a notebook's kernel once per sample, so a CPU time
+# above wall time × threads is capped there.  The critical path is the longest chain of
+# jobs each waiting for the one before: no schedule is shorter, nor shorter than the CPU
+# time over the cores.  Wall times are measured on a shared machine and include the
+# waits for other processes; CPU times do not.
+
+# %%
+per_fig, path, text = dag_summary(dag)
+display(per_fig)
+display(path)
+display(Markdown(text))
 
 # %%
 fig, axes = plt.subplots(2, 2, figsize=(13, 9))

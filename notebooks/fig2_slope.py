@@ -94,6 +94,9 @@ display(Markdown(claim_markdown("s3-warm-no-dispersion", results, "fig2_slope"))
 display(Markdown(claim_markdown("s2-warm-little-indeterminacy", results, "fig2_slope")))
 display(Markdown(claim_markdown("s2-warm-accelerates", results, "fig2_slope")))
 
+# %%
+Markdown(sa.warm_check(ens, cfg["analysis"]["solution_threshold"]) or "The warm runs are plain NLGS.")
+
 # %% [markdown]
 # ## Distinct solutions, and the census of the step's exact solutions
 #

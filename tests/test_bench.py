@@ -83,6 +83,98 @@ def test_rule_times_reads_snakemake_benchmark_files(tmp_path):
     assert np.isnan(ds.max_rss_mb[0]) and ds.max_rss_mb[1] == 250.5
 
 
+DRY_RUN = """Building DAG of jobs...
+[Wed Nov 25 23:52:43 2026]
+rule simulate:
+    input: ncd/a.py
+    output: results/fig9/trajectory.nc
+    log: results/logs/fig9/simulate.log
+    jobid: 3
+    benchmark: results/benchmarks/fig9/simulate.tsv
+    reason: Forced execution
+    resources: tmpdir=/tmp
+[Wed Nov 25 23:52:43 2026]
+localrule explore:
+    input: ncd/a.py, results/fig9/trajectory.nc
+    output: results/fig9/shards/e_0-of-2.nc
+    jobid: 4
+    benchmark: results/benchmarks/fig9/explore_0-of-2.tsv
+    wildcards: shard=0, n=2
+    threads: 2
+[Wed Nov 25 23:52:43 2026]
+rule explore:
+    input: ncd/a.py, results/fig9/trajectory.nc
+    output: results/fig9/shards/e_1-of-2.nc
+    jobid: 5
+    benchmark: results/benchmarks/fig9/explore_1-of-2.tsv
+    wildcards: shard=1, n=2
+    threads: 2
+[Wed Nov 25 23:52:43 2026]
+rule notebook:
+    input: results/fig9/shards/e_0-of-2.nc, results/fig9/shards/e_1-of-2.nc
+    output: results/figures/fig9.png
+    jobid: 6
+    benchmark: results/benchmarks/fig9/notebook.tsv
+[Wed Nov 25 23:52:43 2026]
+rule all:
+    input: results/figures/fig9.png
+    jobid: 0
+Job stats:
+job      count
+"""
+
+
+def test_dry_run_jobs_and_the_critical_path(tmp_path):
+    """Jobs, threads and dependencies read from a dry run's printout; each job's time alone
+    is its CPU time over its threads, a notebook's over-counted CPU time is capped at wall
+    time x threads, and the critical path is the longest chain."""
+    jobs = bench.dry_run_jobs(DRY_RUN)
+    assert [j["rule"] for j in jobs] == ["simulate", "explore", "explore", "notebook", "all"]
+    assert [j["threads"] for j in jobs] == [1, 2, 2, 1, 1]
+    assert jobs[2]["inputs"] == ["ncd/a.py", "results/fig9/trajectory.nc"] and jobs[4]["benchmark"] is None
+    d = tmp_path / "results" / "benchmarks" / "fig9"
+    d.mkdir(parents=True)
+    head = "s\th:m:s\tmax_rss\tmax_vms\tmax_uss\tmax_pss\tio_in\tio_out\tmean_load\tcpu_time\n"
+    for name, wall, cpu in (("simulate", 12, 10), ("explore_0-of-2", 50, 60), ("explore_1-of-2", 50, 80),
+                            ("notebook", 20, 900)):
+        (d / f"{name}.tsv").write_text(head + f"{wall}\t0\t1\t1\t1\t1\t0\t0\t90\t{cpu}\n")
+    ds = bench.dag_table(jobs, tmp_path)
+    np.testing.assert_allclose(ds.cpu_s, [10, 60, 80, 20])
+    np.testing.assert_allclose(ds.alone_s, [10, 30, 40, 20])
+    assert list(ds.critical.values) == [1, 0, 1, 1]
+    assert list(ds.critical_order.values) == [0, -1, 1, 2]
+    assert ds.attrs["critical_path_s"] == 70 and ds.attrs["cpu_s"] == 170
+    assert bench.ideal_time(ds, cores=2) == 85
+    per_fig, path, text = bench.dag_summary(ds.assign_attrs(cores=2))
+    assert list(path.rule) == ["simulate", "explore_1-of-2", "notebook"] and float(per_fig.cpu_s.iloc[0]) == 170
+    assert "critical path 70 s through 3 jobs" in text.lower() and "less than 85 s" in text
+
+
+def test_speed_table_rows_round_trip(tmp_path):
+    """The README's speed rows from a run's bench files, through the committed .tsv, to Markdown."""
+    d = tmp_path / "bench"
+    d.mkdir()
+    xr.Dataset(attrs={"cpu_s": 1234.4, "critical_path_s": 456.7, "ideal_s": 617.25, "cores": 2}).to_netcdf(d / "dag.nc")
+    n = np.array([1000, 10000, 100000])
+    xr.Dataset({"n_discs": ("size", n), "ns_per_update": ("size", [11.0, 12.0, 14.0]),
+                "ns_per_update_c": ("size", [10.0, 11.0, 13.0]), "step_s": ("size", 1e-6 * n ** 1.1),
+                "build_s": ("size", 1e-7 * n)}, coords={"size": n}).to_netcdf(d / "core.nc")
+    rows = bench.speed_rows(tmp_path)
+    assert [r["value"] for r in rows] == ["1234", "457", "617", "12 / 11", "1.10", "1.00"]
+    bench.write_speed_csv(rows, tmp_path / "speed.tsv")
+    assert bench.read_speed_csv(tmp_path / "speed.tsv") == rows
+    block = bench.speed_markdown(rows)
+    text = "intro\n" + bench.speed_markdown([]) + "\nafter\n"
+    assert bench.speed_block(bench.replace_speed_block(text, block)) == block
+    assert "| NLGS contact update, N = 10000: numba / C | 12 / 11 | ns | `results/bench/core.nc` |" in block
+
+
+def test_critical_path_refuses_a_cycle():
+    with pytest.raises(ValueError, match="cycle"):
+        bench.critical_path([1.0, 1.0], [(0, 1), (1, 0)])
+    assert bench.critical_path([], []) == (0.0, [])
+
+
 @pytest.mark.skipif(not Path("/proc/self/status").exists(), reason="Linux only")
 def test_peak_memory_sees_an_allocation():
     with bench.PeakMemory() as mem:
@@ -98,7 +190,7 @@ def bench_results(results):
     d = results / "bench"
     if not (d / "core.nc").exists():
         pytest.skip(f"no benchmark results in {d} (run `snakemake -j2 bench`)")
-    return {k: xr.load_dataset(d / f"{k}.nc") for k in ("core", "sweeps", "ensemble", "peer", "rules")}
+    return {k: xr.load_dataset(d / f"{k}.nc") for k in ("core", "sweeps", "ensemble", "peer", "rules", "dag")}
 
 
 def test_bench_core_data(bench_results):
@@ -162,3 +254,26 @@ def test_tolerance_problems_local_solves(results):
     assert np.array_equal(loc.sweeps.values[none], ds.sel(solver="nlgs").sweeps.values[none])
     assert (ds.local_solves.sel(solver=["nlgs", "anderson", "nlgs+finish"]).values == 0).all()
     assert ds.local_solves.attrs["units"] == "1" and ds.gap_to_nlgs.attrs["long_name"]
+
+
+def test_power_law_recovers_an_exponent():
+    n = np.array([1e3, 1e4, 1e5])
+    p, c = bench.power_law(n, 2e-6 * n ** 1.25)
+    assert abs(p - 1.25) < 1e-12 and abs(c / 2e-6 - 1) < 1e-9
+    assert np.isnan(bench.power_law([1e3], [1.0])[0]) and np.isnan(bench.power_law([1, 2], [0.0, 1.0])[0])
+
+
+def test_bench_dag_has_every_job_and_a_critical_path(bench_results):
+    """dag.nc: every job of the default run with a benchmark file, CPU time at most wall
+    time x threads, and a critical path from a first job to the index, in order, whose
+    length is the sum of its jobs' times alone."""
+    dag = bench_results["dag"]
+    rules = bench_results["rules"]
+    assert dag.sizes["job"] >= rules.sizes["job"] and dag.attrs["dag_jobs"] > dag.sizes["job"]
+    assert (dag.cpu_s <= dag.wall_s * dag.threads + 1e-9).all()
+    np.testing.assert_allclose(dag.attrs["cpu_s"], float(dag.cpu_s.sum()))
+    path = dag.where(dag.critical == 1, drop=True).sortby("critical_order")
+    assert list(path.critical_order.values) == list(range(path.sizes["job"]))
+    assert path.rule.values[-1] == "index"
+    np.testing.assert_allclose(dag.attrs["critical_path_s"], float(path.alone_s.sum()), rtol=1e-9)
+    assert dag.attrs["ideal_s"] >= max(dag.attrs["critical_path_s"], dag.attrs["cpu_s"] / dag.attrs["cores"]) - 1e-9

@@ -355,6 +355,31 @@ def test_the_restart_reproduces_the_trajectory_step(data):
     np.testing.assert_allclose(acc[:, 1], traj.reference_accel_y, rtol=0, atol=1e-9)
 
 
+def test_warm_runs_with_local_exact_solves_land_on_plain_nlgs_solution(data):
+    """The warm runs use local exact solves; the first plain_check_runs members were also run by
+    plain NLGS, and both end points are the same solution at the tightest tolerance (closer
+    than the threshold that tells two solutions apart; at looser ones plain NLGS may still
+    sit on its plateau); the other members are not checked (NaN)."""
+    _, ens, _, cfg, an = data
+    ecfg = cfg["explore"]
+    assert int(ens.attrs["warm_local_exact"]) == int(ecfg["warm_local_exact"])
+    dist = ens.warm_plain_distance
+    checked = ens.run.values < ecfg["plain_check_runs"]
+    assert checked.any() and np.isnan(dist.values[:, ~checked]).all()
+    assert (dist.isel(tol=-1).values[checked] <= an["solution_threshold"]).all()
+    text = sa.warm_check(ens, an["solution_threshold"])
+    assert f"{int(checked.sum())} of them" in text and "same solution" in text
+
+
+def test_warm_check_sentence_on_a_synthetic_ensemble():
+    ens = xr.Dataset({"warm_plain_distance": (("tol", "run"), [[1e-6, np.nan, 3e-5], [2e-7, np.nan, 4e-6]])},
+                     coords={"tol": [1e-6, 1e-8], "run": [0, 1, 2]}, attrs={"warm_local_exact": 1})
+    text = sa.warm_check(ens, 1e-3)
+    assert "2 of them" in text and "4.0e-06 |g|" in text and "same solution" in text
+    assert "different solutions" in sa.warm_check(ens, 1e-6)
+    assert sa.warm_check(ens.assign_attrs(warm_local_exact=0), 1e-3) is None
+
+
 def test_a_member_does_not_depend_on_its_shard(data):
     traj, ens, _, cfg, _ = data
     member = int(ens.run.values[-1])
@@ -422,3 +447,22 @@ def test_angles_say_what_they_hold(data):
     assert bool(elongated.any())
     np.testing.assert_allclose(got.where(elongated).transpose("init", "disc").values,
                                expect.where(elongated).transpose("init", "disc").values, atol=1e-6)
+
+
+def test_census_is_the_same_on_one_and_two_threads(data, results):
+    """The census runs its NLGS runs, Lemke runs, projections and restarts side by side on
+    the rule's threads, adding to the census in a fixed order: census.nc is the same
+    bit for bit whatever the thread count."""
+    import numba
+    traj, ens, meas, cfg, _ = data
+    ref = xr.load_dataset(results / "fig2_slope" / "census.nc")
+    cfg = {**cfg, "census": yaml.safe_load(ref.attrs["config_yaml"])}
+    before = numba.get_num_threads()
+    try:
+        for threads in (1, min(2, numba.config.NUMBA_NUM_THREADS)):
+            numba.set_num_threads(threads)
+            ds = census.census_dataset(traj, ens, meas, cfg)
+            for v in ref.data_vars:
+                np.testing.assert_array_equal(ds[v].values, ref[v].values, err_msg=f"{v}, {threads} threads")
+    finally:
+        numba.set_num_threads(before)

@@ -7,6 +7,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+from ncd.studies.bench import SPEED_START, read_speed_csv, speed_block, speed_markdown
+
 ROOT = Path(__file__).resolve().parent.parent
 README = (ROOT / "README.md").read_text()
 SOLVERS = ROOT / "docs" / "solvers.md"
@@ -20,7 +22,9 @@ def section(title, text=README):
 
 
 def prose(text):
-    """``text`` without fenced code blocks, inline code and HTML tags."""
+    """``text`` without fenced code blocks, inline code, HTML tags and the generated speed
+    table (checked against its source by test_speed_table_is_the_generated_one)."""
+    text = text.replace(speed_block(text), "") if SPEED_START in text else text
     text = re.sub(r"```.*?```", "", text, flags=re.DOTALL)
     text = re.sub(r"`[^`\n]*`", "", text)
     return re.sub(r"<[^>]*>", "", text)
@@ -65,6 +69,18 @@ def test_no_hand_typed_measurements_anywhere():
     assert not found, f"hand-typed measured numbers in README.md: {found}"
     assert "results/html/bench.html" in README and "snakemake -j2 bench" in README
     assert "docs/solvers.md" in README
+
+
+def test_speed_table_is_the_generated_one():
+    """The README's only measured numbers are the speed table, and it is exactly what
+    scripts/speed_table.py generates from its source docs/speed.tsv (no time is checked)."""
+    rows = read_speed_csv(ROOT / "docs" / "speed.tsv")
+    assert speed_block(README) == speed_markdown(rows)
+    assert all(r["source"].startswith("results/bench/") for r in rows)
+    assert "scripts/speed_table.py" in section("Speed")
+    out = subprocess.run([sys.executable, str(ROOT / "scripts" / "speed_table.py"), "--check"],
+                         capture_output=True, text=True, cwd=ROOT)
+    assert out.returncode == 0, out.stdout
 
 
 def test_measurement_pattern_catches_the_usual_forms():

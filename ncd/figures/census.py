@@ -14,7 +14,7 @@ import numpy as np
 import xarray as xr
 import yaml
 
-from ncd.dynamics.explore import explore
+from ncd.dynamics.explore import explore, run_parallel
 from ncd.dynamics.stepper import prepare_step, solve_problem
 from ncd.io.netcdf import provenance
 from ncd.scenes.slope import scene_at_step
@@ -77,10 +77,17 @@ def enumerate_statuses(step, census, max_patterns, ptol, rng, rounds=4, gate=1e-
         pats = [p for p in pats if p.tobytes() not in tried]
         n_per_round.append(len(pats))
         n_clusters.append(ncl)
-        for p in pats:
+        # the projections of a round are independent (each from a solution known at the
+        # round's start): made side by side, then added to the census in pattern order
+        starts = list(census.impulse)
+        projected = [None] * len(pats)
+
+        def project(k, pats=pats, st=st, sw=sw, starts=starts, projected=projected):
+            base = int(np.argmin((st[:, sw] != pats[k][sw]).sum(1)))
+            projected[k] = project_statuses(step.W, step.q.ravel(), step.mu, starts[base], pats[k])
+        run_parallel(project, len(pats))
+        for p, s in zip(pats, projected):
             tried.add(p.tobytes())
-            base = int(np.argmin((st[:, sw] != p[sw]).sum(1)))
-            s = project_statuses(step.W, step.q.ravel(), step.mu, census.impulse[base], p)
             found.append(census.add(s, "enumeration", ptol) if step.residual(s) <= gate else -1)
         if len(census.impulse) == n0:
             break
@@ -123,10 +130,14 @@ def run_census(traj, ens, measures, cfg, log=None):
     t0 = time.perf_counter()
     M, b = frictional_lcp(step.W.toarray(), step.q, step.mu)
     lemke_info = []
-    for j in range(cc["lemke_runs"]):
+    pivoted = [None] * cc["lemke_runs"]
+
+    def pivot(j):      # the runs side by side (Lemke's pivots release the GIL), added in order
         d = np.ones(len(b)) if j == 0 else 10.0 ** np.random.default_rng((j, cc["root_seed"])).uniform(
             -cc["lemke_decades"], cc["lemke_decades"], len(b))
-        x, info = lemke(M, b, covering=d)
+        pivoted[j] = lemke(M, b, covering=d)
+    run_parallel(pivot, cc["lemke_runs"])
+    for j, (x, info) in enumerate(pivoted):
         lemke_info.append(info)
         k = census.add(impulse_of_lcp(x, step.mu), "lemke", ptol) if x is not None else -1
         if k >= 0:
@@ -155,13 +166,18 @@ def run_census(traj, ens, measures, cfg, log=None):
     n_sol = len(census.accel)
     returns = np.zeros(n_sol, np.int64)
     pset = SolverSettings(tol=cc["perturb_tol"], max_sweeps=cc["max_sweeps"], check_every=10)
-    for k, s in enumerate(census.impulse):
-        for j in range(cc["perturb_runs"]):
-            rng = np.random.default_rng((k, j, cc["root_seed"]))
-            guess = s + cc["noise"] * np.abs(s).max() * rng.standard_normal(s.shape)
-            res, vel, _ = solve_problem(scene, problem, guess, rng.permutation(len(s)), pset)
-            a = (vel[:step.nm] - problem.vel_initial[:step.nm]) / step.h
-            returns[k] += bool(res.converged and np.abs(a - census.accel[k]).max() <= basin_tol)
+    back = np.zeros((n_sol, cc["perturb_runs"]), bool)
+
+    def perturb(kj):
+        k, j = divmod(kj, cc["perturb_runs"])
+        s = census.impulse[k]
+        rng = np.random.default_rng((k, j, cc["root_seed"]))
+        guess = s + cc["noise"] * np.abs(s).max() * rng.standard_normal(s.shape)
+        res, vel, _ = solve_problem(scene, problem, guess, rng.permutation(len(s)), pset)
+        a = (vel[:step.nm] - problem.vel_initial[:step.nm]) / step.h
+        back[k, j] = bool(res.converged and np.abs(a - census.accel[k]).max() <= basin_tol)
+    run_parallel(perturb, n_sol * cc["perturb_runs"])
+    returns[:] = back.sum(axis=1)
     # the straight segment between the two most visited NLGS solutions
     seg_t = np.array(cc["segment_points"])
     counts = np.array([(label_ens == k).sum() for k in range(n_sol)])

@@ -236,16 +236,18 @@ def scene_at_step(traj, cfg):
     return scene
 
 
-def run_member(scene, problem, member, root_seed, init, tolerances, ecfg):
+def run_member(scene, problem, member, root_seed, init, tolerances, ecfg, local_exact=False):
     """One NLGS run with the random review order of ``member``, continued from
     tolerance to tolerance (each stage restarts from the previous impulses with
     the same order).  Returns per-tolerance accelerations and diagnostics and
-    the impulses and statuses at the last tolerance."""
+    the impulses and statuses at the last tolerance.  ``local_exact``: every stage
+    with local exact solves where the residual stalls (:mod:`ncd.solver.local_exact`)."""
     h, nm = problem.h, scene.n_mobile
     out = {"accel": np.zeros((len(tolerances), nm, 2)), "sweeps": np.zeros(len(tolerances), np.int64),
            "residual": np.zeros(len(tolerances)), "converged": np.zeros(len(tolerances), bool),
            "wall_time": np.zeros(len(tolerances))}
-    first = SolverSettings(tol=tolerances[0], max_sweeps=ecfg["max_sweeps"], check_every=ecfg["check_every"])
+    first = SolverSettings(tol=tolerances[0], max_sweeps=ecfg["max_sweeps"], check_every=ecfg["check_every"],
+                           local_exact=local_exact)
     res = explore(scene, problem, [member], root_seed, init=init, review="random", settings=first)
     order = member_rng(member, root_seed).permutation(problem.contacts.n)  # the order explore drew
     impulse, vel, spin = res["impulse"][0], res["vel"][0], res["spin"][0]
@@ -259,7 +261,8 @@ def run_member(scene, problem, member, root_seed, init, tolerances, ecfg):
                 t0 = time.perf_counter()
                 result, v, w = solve_problem(scene, problem, impulse, order,
                                              SolverSettings(tol=tol, max_sweeps=budget,
-                                                            check_every=ecfg["check_every"]))
+                                                            check_every=ecfg["check_every"],
+                                                            local_exact=local_exact))
                 wall += time.perf_counter() - t0
                 impulse, vel, spin, residual = result.impulse, v[:nm], w[:nm], result.residual
                 sweeps += result.sweeps
@@ -294,9 +297,20 @@ def run_ensemble(traj, cfg, members, progress=None):
     spin_acc = np.zeros((len(INITS), nr, nm))
     status = np.zeros((len(INITS), nr, nc), np.int8)
     total = len(INITS) * nr
+    # the warm runs with local exact solves (a fifteenth of plain NLGS's sweeps to 1e-8);
+    # the members below plain_check_runs are also run warm by plain NLGS: their distance
+    # to the local-exact run says whether both land on the same solution
+    local = bool(ecfg["warm_local_exact"])
+    checked = np.flatnonzero(members < ecfg["plain_check_runs"]) if local else np.zeros(0, np.int64)
+    plain_distance = np.full((nt, nr), np.nan)
+    g = float(np.hypot(*scene.gravity))
     for i, init in enumerate(INITS):
         def task(r, i=i, init=init):
-            out = run_member(scene, problem, members[r], ecfg["root_seed"], init, tolerances, ecfg)
+            out = run_member(scene, problem, members[r], ecfg["root_seed"], init, tolerances, ecfg,
+                             local_exact=local and init == "warm")
+            if local and init == "warm" and r in checked:
+                plain = run_member(scene, problem, members[r], ecfg["root_seed"], init, tolerances, ecfg)
+                plain_distance[:, r] = np.abs(out["accel"] - plain["accel"]).max(axis=(1, 2)) / g
             acc[i, :, r] = out["accel"]
             for k in diag:
                 diag[k][i, :, r] = out[k]
@@ -324,16 +338,22 @@ def run_ensemble(traj, cfg, members, progress=None):
             "contact_mu": ("contact", c.mu),
             "warm_guess_n": ("contact", warm[:, 0]),
             "warm_guess_t": ("contact", warm[:, 1]),
+            "warm_plain_distance": (("tol", "run"), plain_distance),
         },
         coords={"init": list(INITS), "tol": tolerances, "run": members, "disc": np.arange(nm),
                 "contact": np.arange(nc)},
-        attrs=provenance(cfg, root_seed=ecfg["root_seed"], max_sweeps=ecfg["max_sweeps"],
+        attrs=provenance(cfg, root_seed=ecfg["root_seed"], max_sweeps=ecfg["max_sweeps"], warm_local_exact=int(local),
                          check_every=ecfg["check_every"], h=float(traj.attrs["h"]),
                          investigated_step=int(traj.attrs["investigated_step"]),
                          gravity_x=scene.gravity[0], gravity_y=scene.gravity[1]),
     )
     ds["status"].attrs["description"] = "final status per contact: 0 no contact, 1 stick, 2/3 slide, 4 fallback"
     ds["sweeps"].attrs["description"] = "cumulative sweeps of the run when it reached this tolerance"
+    ds["warm_plain_distance"].attrs.update(
+        units="1", long_name="warm run with local exact solves against plain NLGS",
+        description=("largest grain acceleration difference over |g| between the warm run with local exact "
+                     "solves and the plain-NLGS warm run of the same member (explore.plain_check_runs "
+                     "first members; NaN: not checked)"))
     ds["wall_time"].attrs["description"] = ("cumulative wall time (s) of the run at this tolerance, measured while "
                                             "the rule's other threads ran other members (a measurement)")
     return ds

@@ -5,8 +5,9 @@
 spread against the tolerance), :func:`contact_relation` (the paper's question of why the
 dispersion is a line: switching contacts, sticking clusters and their rigid-motion fit),
 :func:`cloud_against_census` (the cloud read through the exact solutions of
-:mod:`ncd.figures.census`), :func:`status_patterns` (status combinations for the census)
-and :func:`measures_dataset` (all of it as ``measures.nc``).
+:mod:`ncd.figures.census`), :func:`status_patterns` (status combinations for the census),
+:func:`warm_check` (the warm runs with local exact solves against plain NLGS) and
+:func:`measures_dataset` (all of it as ``measures.nc``).
 """
 import itertools
 
@@ -314,6 +315,30 @@ def cloud_against_census(ens, census, grain, init="zero"):
             "rms_offset": float(np.sqrt(np.mean(np.sum(E[lab] ** 2, 1)))) if lab.any() else np.nan,
             "max_offset": float(np.hypot(*E[lab].T).max()) if lab.any() else np.nan, "g": g,
             "n_solutions": len(A)}
+
+
+def warm_check(ens, threshold):
+    """The check of the warm runs made with local exact solves against plain NLGS from the
+    same warm start and review order (``warm_plain_distance`` of the ensemble, the largest
+    grain acceleration difference over ``|g|``): a sentence with the number of checked
+    members, the largest distance at the tightest tolerance and whether it is below
+    ``threshold`` (in ``|g|``, the distance that tells two solutions apart).  None when the
+    ensemble's warm runs are plain NLGS (nothing to check)."""
+    if "warm_plain_distance" not in ens or not int(ens.attrs.get("warm_local_exact", 0)):
+        return None
+    tight = float(ens.tol.min())
+    dist = ens.warm_plain_distance.sel(tol=tight).values
+    checked = np.isfinite(dist)
+    if not checked.any():
+        return "The warm runs use local exact solves; no member was also run by plain NLGS."
+    worst = float(dist[checked].max())
+    same = worst <= threshold
+    return (f"The warm runs use local exact solves where the residual stalls; {int(checked.sum())} of them were "
+            f"also run by plain NLGS from the same warm start and review order: at tolerance {tight:.0e} the two "
+            f"end points differ by at most {worst:.1e} |g| in a grain's acceleration, "
+            + (f"below the {threshold:.0e} |g| that tells two solutions apart: both land on the same solution."
+               if same else f"above the {threshold:.0e} |g| that tells two solutions apart: they land on "
+                            "different solutions."))
 
 
 def measures_dataset(traj, ens, cfg):

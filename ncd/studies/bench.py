@@ -4,7 +4,9 @@
 C on the same packed arrays, ``c_sweep.c``, which must give the same impulses bit for bit;
 detection, step preparation, time per step, peak memory), :func:`sweeps_table` (sweeps to
 a fixed tolerance against N), :func:`ensemble_table` (1 against 2 threads, bit-for-bit
-equal), :func:`startup` and :func:`rule_times` (every pipeline rule's ``benchmark:`` file).
+equal), :func:`startup`, :func:`rule_times` (every pipeline rule's ``benchmark:`` file) and
+:func:`dag_table` (the DAG of a run, each job's CPU seconds from its benchmark file, and
+the critical path: the longest chain of jobs each waiting for the one before).
 The packing is a jittered triangular lattice in a box whose neighbours overlap slightly,
 about three contacts per disc, as in a jammed packing.
 """
@@ -21,6 +23,7 @@ from pathlib import Path
 import numba
 import numpy as np
 import xarray as xr
+import yaml
 
 from ncd.core.contacts import detect_contacts
 from ncd.core.scene import make_scene
@@ -50,12 +53,18 @@ def dense_packing(n, seed=0, s=1.0):
     return make_scene(pos, radius, 1.0, walls=walls, mu=0.5, overlap_tolerance=0.06)
 
 
+# The timings of one process are its CPU seconds (user + system), not wall time: on a
+# shared machine the wall time of a loop counts the other processes' turns on the cores.
+# The C reference loop reads the same clock (CLOCK_PROCESS_CPUTIME_ID).
+clock = time.process_time
+
+
 def best_of(fn, repeat):
     times = []
     for _ in range(repeat):
-        t0 = time.perf_counter()
+        t0 = clock()
         fn()
-        times.append(time.perf_counter() - t0)
+        times.append(clock() - t0)
     return min(times)
 
 
@@ -113,10 +122,10 @@ def nlgs_sweep_cost(scene, problem, sweeps, repeat, order=None):
     best, imp = np.inf, None
     for _ in range(repeat):
         b, imp = body.copy(), np.zeros(2 * n)
-        t0 = time.perf_counter()
+        t0 = clock()
         for _ in range(sweeps):
             sweep_discs((pair, coef, b, imp), order, status)
-        best = min(best, time.perf_counter() - t0)
+        best = min(best, clock() - t0)
     return best / sweeps, imp
 
 
@@ -146,7 +155,9 @@ def c_sweep_cost(scene, problem, sweeps, workdir):
 def core_row(n, cfg, workdir):
     """One size of :func:`core_table`."""
     with PeakMemory() as mem:
+        t0 = clock()
         scene = dense_packing(n)
+        build = clock() - t0
         problem = prepare_step(scene, H)
         settings = SolverSettings(tol=cfg["step_tol"], max_sweeps=cfg["step_sweeps"], check_every=10)
         step(scene, H, settings=settings)
@@ -158,12 +169,13 @@ def core_row(n, cfg, workdir):
     t_c, imp_c = c_sweep_cost(scene, problem, sweeps, workdir)
     reports, times = [], []
     for _ in range(cfg["steps"]):
-        t0 = time.perf_counter()
+        t0 = clock()
         reports.append(step(scene, H, settings=settings))
-        times.append(time.perf_counter() - t0)
+        times.append(clock() - t0)
     nc = problem.contacts.n
     return {
-        "n_discs": scene.n_mobile, "n_contacts": nc,
+        "n_discs": scene.n_mobile, "n_contacts": nc, "build_s": build,
+        "sweep_s": t_sweep,
         "ns_per_update": 1e9 * t_sweep / nc, "ns_per_update_c": 1e9 * t_c / nc,
         "ns_per_update_interleaved": 1e9 * t_inter / nc,
         # the C loop performs the same floating-point operations in the same order
@@ -177,13 +189,15 @@ def core_row(n, cfg, workdir):
     }
 
 
-UNITS = {"ns_per_update": ("ns", "numba NLGS sweep: time per contact update"),
+UNITS = {"ns_per_update": ("ns", "numba NLGS sweep: CPU time per contact update"),
          "ns_per_update_c": ("ns", "the same sweep in C (gcc -O3 -ffp-contract=off): "
-                                   "time per contact update"),
-         "ns_per_update_interleaved": ("ns", "numba NLGS sweep in the interleaved review order"),
+                                   "CPU time per contact update"),
+         "ns_per_update_interleaved": ("ns", "numba NLGS sweep in the interleaved review order: CPU time per contact update"),
          "c_agrees": ("1", "1 if the C and numba sweeps give the same impulses bit for bit"),
-         "detect_s": ("s", "contact detection"), "prepare_s": ("s", "step preparation (with detection)"),
-         "step_s": ("s", "Moreau-Jean step, warm start"), "step_sweeps": ("1", "mean NLGS sweeps per step"),
+         "build_s": ("s", "CPU time to build the packing (make_scene: positions, radii, checks)"),
+         "sweep_s": ("s", "CPU time of one NLGS sweep over every contact"),
+         "detect_s": ("s", "CPU time of contact detection"), "prepare_s": ("s", "CPU time of step preparation (with detection)"),
+         "step_s": ("s", "CPU time of a Moreau-Jean step, warm start"), "step_sweeps": ("1", "mean NLGS sweeps per step"),
          "step_converged": ("1", "fraction of steps converged within the sweep budget"),
          "peak_memory": ("B", "peak resident memory of the process while building the packing and making one step"),
          "memory_growth": ("B", "peak resident memory above the process's resident memory before the build")}
@@ -204,6 +218,27 @@ def core_table(cfg, log=None):
     for k, (units, name) in UNITS.items():
         ds[k].attrs.update(units=units, long_name=name)
     return ds
+
+
+def power_law(n, t):
+    """Exponent and prefactor ``(p, c)`` of the least-squares fit ``t = c n^p`` in log-log
+    (NaN with fewer than two sizes or a non-positive time)."""
+    n, t = np.asarray(n, float), np.asarray(t, float)
+    if len(n) < 2 or np.any(t <= 0) or np.any(n <= 0):
+        return float("nan"), float("nan")
+    p, logc = np.polyfit(np.log(n), np.log(t), 1)
+    return float(p), float(np.exp(logc))
+
+
+SCALING = {"build_s": "building the packing", "prepare_s": "step preparation (detection, Delassus blocks)",
+           "sweep_s": "one NLGS sweep", "step_s": "one Moreau-Jean step (warm start, NLGS to step_tol)"}
+
+
+def scaling_table(core):
+    """Time against N of :data:`SCALING`'s quantities of a :func:`core_table` Dataset, each
+    with its fitted exponent ``p`` (``t = c N^p``): a list of ``(what, times, p)``."""
+    n = core.n_discs.values
+    return [(name, core[k].values, power_law(n, core[k].values)[0]) for k, name in SCALING.items()]
 
 
 def sweeps_table(cfg, log=None):
@@ -355,3 +390,239 @@ def rule_times(paths):
                        "seconds": ("job", np.array([r[2] for r in rows])),
                        "max_rss_mb": ("job", np.array([r[3] for r in rows]))},
                       coords={"job": np.arange(len(rows))})
+
+
+def dry_run_jobs(text):
+    """The jobs of a Snakemake dry run's printout (``snakemake -n --forceall --cores N``):
+    a list of dicts with ``rule``, ``inputs``, ``outputs``, ``benchmark`` (None when the
+    rule has none) and ``threads`` (1 when not printed).  Snakemake prints a job's block
+    as ``rule NAME:`` (or ``localrule``/``checkpoint``) and indented ``key: value`` lines."""
+    jobs, job = [], None
+    for line in text.splitlines():
+        head = line.split()[0] if line.strip() else ""
+        if head in ("rule", "localrule", "checkpoint") and line.rstrip().endswith(":"):
+            job = {"rule": line.split()[1].rstrip(":"), "inputs": [], "outputs": [], "benchmark": None,
+                   "threads": 1}
+            jobs.append(job)
+        elif job is not None and line.startswith("    ") and ":" in line:
+            key, value = (x.strip() for x in line.split(":", 1))
+            if key in ("input", "output"):
+                job[key + "s"] = [v.strip() for v in value.split(",") if v.strip()]
+            elif key == "benchmark":
+                job["benchmark"] = value
+            elif key == "threads":
+                job["threads"] = int(value)
+        elif not line.startswith(" "):
+            job = None
+    return jobs
+
+
+def read_benchmark(path):
+    """``(wall_s, cpu_s)`` of a Snakemake benchmark file (its first record).  Snakemake's
+    ``cpu_time`` counts a child process's time once per sample (a notebook's kernel), so
+    a value above what the job's threads could spend in its wall time is capped there."""
+    lines = Path(path).read_text().splitlines()
+    rec = dict(zip(lines[0].split("\t"), lines[1].split("\t")))
+    wall = float(rec["s"])
+    cpu = float(rec["cpu_time"]) if rec.get("cpu_time", "NA") not in ("-", "NA", "") else wall
+    return wall, cpu
+
+
+def critical_path(durations, edges):
+    """Length and jobs of the longest chain of a DAG: ``durations[j]`` the time of job ``j``,
+    ``edges`` pairs ``(a, b)``, b needing a.  The jobs are listed first to last."""
+    n = len(durations)
+    preds = [[] for _ in range(n)]
+    succs = [[] for _ in range(n)]
+    for a, b in edges:
+        preds[b].append(a)
+        succs[a].append(b)
+    indeg = [len(p) for p in preds]
+    ready = [j for j in range(n) if indeg[j] == 0]
+    finish = np.zeros(n)
+    via = np.full(n, -1)
+    while ready:
+        j = ready.pop()
+        start = max((finish[p] for p in preds[j]), default=0.0)
+        if preds[j]:
+            via[j] = max(preds[j], key=lambda p: finish[p])
+        finish[j] = start + durations[j]
+        for b in succs[j]:
+            indeg[b] -= 1
+            if indeg[b] == 0:
+                ready.append(b)
+    if np.any(np.array(indeg) > 0):
+        raise ValueError("the job graph has a cycle")
+    if n == 0:
+        return 0.0, []
+    last = int(np.argmax(finish))
+    path = [last]
+    while via[path[-1]] >= 0:
+        path.append(int(via[path[-1]]))
+    return float(finish[last]), path[::-1]
+
+
+def dag_table(jobs, root="."):
+    """The jobs of a run with a benchmark file, as a Dataset over ``job``: figure (the
+    benchmark's folder; "index" for the files at the top), rule (its name), threads, wall and CPU seconds, and the time the
+    job would take alone on its threads (``cpu / threads``), from which the critical path
+    of the DAG is found (``critical``: 1 on it).  Attributes: ``critical_path_s``,
+    ``cpu_s`` (all jobs) and ``ideal_s`` (the larger of the critical path and the CPU
+    seconds over the cores: no schedule on ``cores`` cores is shorter)."""
+    root = Path(root)
+    producer = {out: k for k, job in enumerate(jobs) for out in job["outputs"]}
+    edges = sorted({(producer[i], k) for k, job in enumerate(jobs) for i in job["inputs"] if i in producer})
+    rows = []
+    for job in jobs:
+        bench = job["benchmark"]
+        if bench is None or not (root / bench).exists():
+            rows.append(None)
+            continue
+        wall, cpu = read_benchmark(root / bench)
+        cpu = min(cpu, wall * job["threads"])
+        folder = Path(bench).parent.name
+        rows.append((folder if folder != "benchmarks" else "index", Path(bench).stem, job["threads"], wall, cpu))
+    durations = [0.0 if r is None else r[4] / r[2] for r in rows]
+    length, path = critical_path(durations, edges)
+    keep = [k for k, r in enumerate(rows) if r is not None]
+    on_path = set(path)
+    step = {k: i for i, k in enumerate(p for p in path if rows[p] is not None)}
+    ds = xr.Dataset({"figure": ("job", [rows[k][0] for k in keep]),
+                     "rule": ("job", [rows[k][1] for k in keep]),
+                     "threads": ("job", np.array([rows[k][2] for k in keep], np.int64)),
+                     "wall_s": ("job", np.array([rows[k][3] for k in keep])),
+                     "cpu_s": ("job", np.array([rows[k][4] for k in keep])),
+                     "alone_s": ("job", np.array([durations[k] for k in keep])),
+                     "critical": ("job", np.array([int(k in on_path) for k in keep], np.int8)),
+                     "critical_order": ("job", np.array([step.get(k, -1) for k in keep], np.int64))},
+                    coords={"job": np.arange(len(keep))})
+    cpu = float(ds.cpu_s.sum())
+    ds.attrs.update(critical_path_s=length, cpu_s=cpu, jobs=len(keep))
+    meta = {"wall_s": ("s", "wall time of the job (shared machine: others' jobs included)"),
+            "cpu_s": ("s", "CPU time of the job (user + system), at most wall time x threads"),
+            "alone_s": ("s", "CPU time over threads: the job's time alone on its threads"),
+            "threads": ("1", "threads of the job"),
+            "critical": ("1", "1: the job is on the critical path of the DAG"),
+            "critical_order": ("1", "position on the critical path (-1: not on it)"),
+            "figure": ("1", "folder of the benchmark file"), "rule": ("1", "name of the benchmark file")}
+    for k, (units, name) in meta.items():
+        ds[k].attrs.update(units=units, long_name=name)
+    return ds
+
+
+def dag_summary(ds):
+    """For the bench page, from a :func:`dag_table` Dataset with its run's attributes: CPU and
+    wall seconds per figure, the jobs of the critical path in order, and a sentence."""
+    jobs = ds.to_dataframe()
+    per_fig = jobs.groupby("figure")[["cpu_s", "wall_s"]].sum().sort_values("cpu_s", ascending=False).round(1)
+    path = jobs[jobs.critical == 1].sort_values("critical_order")[["figure", "rule", "threads", "cpu_s", "alone_s"]]
+    cores = int(ds.attrs.get("cores", 2))
+    top = per_fig.index[0] if len(per_fig) else "none"
+    text = (f"{int(ds.attrs['jobs'])} jobs, {float(ds.attrs['cpu_s']):.0f} CPU seconds in all ({top} the largest, "
+            f"{float(per_fig.cpu_s.iloc[0]) if len(per_fig) else 0.0:.0f} s).  Critical path "
+            f"{float(ds.attrs['critical_path_s']):.0f} s through {len(path)} jobs ("
+            + ", ".join(f"{r.figure}/{r.rule}" for r in path.itertuples()) + f"); no run on {cores} cores "
+            f"takes less than {ideal_time(ds, cores):.0f} s.")
+    return per_fig, path.round(1).reset_index(drop=True), text
+
+
+def ideal_time(ds, cores=2):
+    """The shortest a run of the jobs of ``ds`` (:func:`dag_table`) can take on ``cores``
+    cores: the larger of its critical path and its CPU seconds spread over the cores."""
+    return max(float(ds.attrs["critical_path_s"]), float(ds.attrs["cpu_s"]) / cores)
+
+
+def dry_run(targets, config, cores=2, workdir="."):
+    """The printout of ``snakemake -n --forceall`` for ``targets`` with ``config`` (a dict,
+    passed as a config file): every job of a full run, whatever is built already.  No lock
+    is taken, so a running Snakemake (the one running this) is not disturbed."""
+    with tempfile.TemporaryDirectory() as tmp:
+        cfg = Path(tmp) / "config.yaml"
+        cfg.write_text(yaml.safe_dump(config, sort_keys=True))
+        # the targets first: --configfile takes every argument after it
+        cmd = [sys.executable, "-m", "snakemake", *targets, "-n", "--forceall", "--nolock", "--cores", str(cores),
+               "--configfile", str(cfg)]
+        out = subprocess.run(cmd, cwd=workdir, capture_output=True, text=True, check=True)
+    return out.stdout + out.stderr
+
+
+SPEED_COLUMNS = ("quantity", "value", "unit", "source")
+SPEED_START, SPEED_END = "<!-- speed table: scripts/speed_table.py -->", "<!-- end of speed table -->"
+
+
+def _sig(x, digits=3):
+    """``digits`` significant digits, and every digit of the integer part above them."""
+    x = float(x)
+    return f"{x:.0f}" if abs(x) >= 10 ** digits else f"{x:.{digits}g}"
+
+
+def speed_rows(results):
+    """The rows of the README's speed table, read from a run's ``results/bench/*.nc``
+    (those present): a list of dicts with :data:`SPEED_COLUMNS`, values as printed."""
+    bench_dir = Path(results) / "bench"
+    rows = []
+
+    def row(quantity, value, unit, source):
+        rows.append({"quantity": quantity, "value": value, "unit": unit, "source": f"results/bench/{source}"})
+
+    if (bench_dir / "dag.nc").exists():
+        dag = xr.load_dataset(bench_dir / "dag.nc")
+        cores = int(dag.attrs["cores"])
+        row("default run: CPU time of all jobs", _sig(dag.attrs["cpu_s"]), "s", "dag.nc")
+        row("default run: critical path of the DAG", _sig(dag.attrs["critical_path_s"]), "s", "dag.nc")
+        row(f"default run: shortest possible on {cores} cores", _sig(dag.attrs["ideal_s"]), "s", "dag.nc")
+    if (bench_dir / "core.nc").exists():
+        core = xr.load_dataset(bench_dir / "core.nc")
+        k = int(np.argmin(np.abs(core.n_discs.values - 10_000)))
+        n = int(core.n_discs.values[k])
+        row(f"NLGS contact update, N = {n}: numba / C", f"{_sig(core.ns_per_update.values[k])} / "
+            f"{_sig(core.ns_per_update_c.values[k])}", "ns", "core.nc")
+        for name, var in (("one Moreau-Jean step", "step_s"), ("building a packing", "build_s")):
+            if var in core:
+                p, _ = power_law(core.n_discs.values, core[var].values)
+                row(f"{name} against N: exponent p of t ~ N^p", f"{p:.2f}", "1", "core.nc")
+    if (bench_dir / "tolerance_problems.nc").exists():
+        tp = xr.load_dataset(bench_dir / "tolerance_problems.nc")
+        tight = float(tp.tol.min())
+        for problem, label in (("fig2_step_warm", "fig2's step, warm start"), ("pile", "the pile's final state")):
+            if problem in tp.problem.values:
+                t = tp.seconds.sel(problem=problem, tol=tight).median("order")
+                row(f"{label}, to {tight:.0e}: plain NLGS / local exact solves",
+                    f"{_sig(t.sel(solver='nlgs'))} / {_sig(t.sel(solver='nlgs+local'))}", "s",
+                    "tolerance_problems.nc")
+    if (bench_dir / "peer.nc").exists():
+        peer = xr.load_dataset(bench_dir / "peer.nc")
+        row("poured pile, median step: ncd / pymunk", f"{_sig(peer.time_median.sel(engine='ncd') * 1e3)} / "
+            f"{_sig(peer.time_median.sel(engine='pymunk') * 1e3)}", "ms", "peer.nc")
+    return rows
+
+
+def write_speed_csv(rows, path):
+    """The rows of :func:`speed_rows` as a tab-separated file (the table's committed source)."""
+    lines = ["\t".join(SPEED_COLUMNS)] + ["\t".join(r[c] for c in SPEED_COLUMNS) for r in rows]
+    Path(path).write_text("\n".join(lines) + "\n")
+
+
+def read_speed_csv(path):
+    lines = Path(path).read_text().splitlines()
+    head = lines[0].split("\t")
+    return [dict(zip(head, line.split("\t"))) for line in lines[1:] if line]
+
+
+def speed_markdown(rows):
+    """The README's speed block: the markers and a Markdown table of ``rows``."""
+    table = ["| quantity | value | unit | from |", "| --- | ---: | --- | --- |"]
+    table += [f"| {r['quantity']} | {r['value']} | {r['unit']} | `{r['source']}` |" for r in rows]
+    return "\n".join([SPEED_START, *table, SPEED_END])
+
+
+def replace_speed_block(text, block):
+    """``text`` (the README) with its speed block replaced by ``block``."""
+    start, end = text.index(SPEED_START), text.index(SPEED_END) + len(SPEED_END)
+    return text[:start] + block + text[end:]
+
+
+def speed_block(text):
+    """The speed block of ``text`` (the README), markers included."""
+    start, end = text.index(SPEED_START), text.index(SPEED_END) + len(SPEED_END)
+    return text[start:end]

@@ -8,6 +8,8 @@
 #   ensemble  NLGS ensemble on 1 and 2 threads                  -> results/bench/ensemble.nc
 #   peer      ncd and pymunk side by side on a poured pile      -> results/bench/peer.nc
 #   rules     wall time of every rule of the figures' run       -> results/bench/rules.nc
+#   dag       CPU seconds of every job of the default run and the
+#             critical path of its DAG                          -> results/bench/dag.nc
 #   notebook  notebooks/bench.ipynb                             -> results/figures/bench.png|pdf
 # Every timing rule asks for all the cores (threads: BENCH_THREADS), so that with -j2
 # Snakemake runs it alone: no other job competes with what it measures.
@@ -130,6 +132,27 @@ rule bench_rules:
         "../scripts/bench_rules.py"
 
 
+rule bench_dag:
+    """CPU seconds of every job of the default run and the critical path of its DAG
+    (the job graph from a dry run, the times from the benchmark files)."""
+    input:
+        [figure_targets(f) for f in FIGURES],
+        "results/index.html",
+    output:
+        "results/bench/dag.nc",
+    params:
+        targets=["all"],
+        cores=2,
+    log:
+        log(FIGB, "dag"),
+    benchmark:
+        bench(FIGB, "dag")
+    conda:
+        CONDA_ENV
+    script:
+        "../scripts/bench_dag.py"
+
+
 rule bench_notebook:
     input:
         core="results/bench/core.nc",
@@ -139,6 +162,7 @@ rule bench_notebook:
         ensemble="results/bench/ensemble.nc",
         peer="results/bench/peer.nc",
         rules="results/bench/rules.nc",
+        dag="results/bench/dag.nc",
         notebook=notebook_file("bench"),
         notebook_py=notebook_file("bench", "py"),
         pages=page_sources("notebook"),

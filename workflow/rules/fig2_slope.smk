@@ -100,6 +100,9 @@ rule fig2_slope_census:
         measures=f"{F2}/measures.nc",
     output:
         f"{F2}/census.nc",
+    # its random-guess NLGS runs, Lemke runs, status projections and perturbed restarts run
+    # side by side on these threads (census.nc identical whatever the count)
+    threads: ENSEMBLE_THREADS
     params:
         config={k: CFG2[k] for k in ("scene", "flow", "census")},
     log:
