@@ -95,7 +95,7 @@ display(Markdown(claim_markdown("s2-warm-little-indeterminacy", results, "fig2_s
 display(Markdown(claim_markdown("s2-warm-accelerates", results, "fig2_slope")))
 
 # %%
-Markdown(sa.warm_check(ens, cfg["analysis"]["solution_threshold"]) or "The warm runs are plain NLGS.")
+display(Markdown(sa.warm_check(ens, cfg["analysis"]["solution_threshold"]) or "The warm runs are plain NLGS."))
 
 # %% [markdown]
 # ## Distinct solutions, and the census of the step's exact solutions
