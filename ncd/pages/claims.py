@@ -31,6 +31,7 @@ from ncd.figures import faces
 from ncd.figures import governing_claims as unger
 from ncd.figures.governing_summary import factor_table, line_counts
 from ncd.solver.convergence import REST
+from ncd.studies.stability_page import inaccurate
 
 TABLE = Path(__file__).with_name("paper_claims.yaml")
 
@@ -62,6 +63,12 @@ def _open(results, rel):
 
 def _pct(x):
     return f"{100 * x:.1f} %"
+
+
+def _span(x, fmt):
+    """``a–b`` of the range of ``x``, or ``a`` when both ends print the same."""
+    lo, hi = format(np.min(x), fmt), format(np.max(x), fmt)
+    return lo if lo == hi else f"{lo}–{hi}"
 
 
 def _v(value, verdict, criterion, claim_id, *data):
@@ -160,19 +167,12 @@ def fig1_review_orders(results):
 STAB = "stability/table.nc"
 
 
-def stability_inaccurate(tab):
-    """Bounded but wrong (the stability page's rule): a tenth of a radius of
-    interpenetration, tunnelling, or NLGS stopped at its sweep budget."""
-    return (tab.stable.values == 1) & ((tab.max_penetration.values > 0.1) | (tab.tunnelled.values == 1)
-                                       | (tab.unconverged_steps.values > 0))
-
-
 def stability_cd_md(results):
     tab = _open(results, STAB)
     method, ratio = tab.method.values.astype(str), tab.h_over_hcrit.values
     cd, md = method == "CD", method == "MD"
     bounded = cd & (tab.diverged.values == 0)
-    accurate = bounded & ~stability_inaccurate(tab)
+    accurate = bounded & ~inaccurate(tab)
     md_big = md & (ratio >= 2)
     md_unstable = md_big & (tab.stable.values == 0)
     usable = accurate & (ratio >= 2)
@@ -203,7 +203,7 @@ def restitution(results):
     ok = abs(ratio + e) < 1e-9 and chain.any() and drift < 1e-6
     return _v(f"binary collision, e = {e}: U_f/U_i = {ratio:.6f} (Newton: −{e}); multicontact e = 1 chain "
               f"({chain.sum()} CD runs): energy drift ≤ {drift:.1e}, last disc leaves at "
-              f"{last.min():.2f}–{last.max():.2f} of the striker's speed (Newton's cradle: 1)",
+              f"{_span(last, '.2f')} of the striker's speed (Newton's cradle: 1)",
               REPRODUCED if ok else DIFFERS,
               "Newton's law in a binary collision; a multicontact impact handled with energy kept "
               "(not the sequence of binary collisions of Newton's cradle)", "s2-restitution", STAB)
