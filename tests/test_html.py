@@ -210,21 +210,52 @@ def test_external_urls_and_layout_record():
     plt.close(fig)
 
 
+def page_layouts(results, name, dom):
+    """The layouts of the page's figures; a page that shows its figure by ``plt.show()`` (no
+    layout record on the page) is judged on its saved PNG, shown at the page's widest image."""
+    from PIL import Image
+
+    from ncd.pages.notebook import LAYOUT_KEY
+
+    found = figure_layouts(dom)
+    png = results / "figures" / f"{name}.png"
+    if found or not png.exists():
+        return found
+    img = Image.open(png)
+    if LAYOUT_KEY not in img.text:
+        return []
+    width = max((float(i["data-w"]) for i in dom.find_all("img") if i.get("data-w")), default=img.width)
+    return [(width / img.width, json.loads(img.text[LAYOUT_KEY]))]
+
+
+def built_page(results, name):
+    page = results / "html" / f"{name}.html"
+    if not page.exists():
+        pytest.skip(f"{name} not built in this run")
+    return page
+
+
+_DOMS = {}
+
+
+def laid_out(page):
+    """:func:`probed_dom` of ``page``, once per test session."""
+    if page not in _DOMS:
+        _DOMS[page] = probed_dom(page, None)
+    return _DOMS[page]
+
+
 @pytest.mark.slow
 @pytest.mark.pipeline
 @needs_chromium
 @pytest.mark.parametrize("name", PAGES)
-def test_page_offline_navigated_legible(results, name, tmp_path):
+def test_page_offline_navigated_legible(results, name):
     """Each page: no external URL, no Out[n] prompt, its human title, a header linking to the
     index, its neighbours in FIGURES' order (files that exist) and the paper; in chromium, no
-    overlapping texts in its figures (PNG layout records, inline SVG) and fonts of at least
-    MIN_FONT_PT at the size the page shows them."""
-    from ncd.pages.notebook import MIN_FONT_PT
+    overlapping texts in its figures (PNG layout records of ncd.pages.notebook.save, inline SVG)."""
     from ncd.pages.render import INDEX, PAPER_URL, neighbours, title_of
 
-    page = results / "html" / f"{name}.html"
-    if not page.exists():
-        pytest.skip(f"{name} not built in this run")
+    page = built_page(results, name)
     html = page.read_text(encoding="utf-8")
     assert external_urls(html) == [], f"{name}: external URLs"
     soup = BeautifulSoup(html, "html.parser")
@@ -239,10 +270,22 @@ def test_page_offline_navigated_legible(results, name, tmp_path):
         assert (a is None) == (want is None), f"{name}: {cls} link"
         if a is not None:
             assert a["href"] == f"{want}.html" and (page.parent / a["href"]).exists(), a["href"]
-    dom = probed_dom(page, tmp_path)
+    dom = laid_out(page)
     assert dom.body["data-svg-overlaps"] == "0", f"{name}: overlapping SVG texts"
-    for scale, lay in figure_layouts(dom):
+    for _, lay in page_layouts(results, name, dom):
         assert lay["overlaps"] == [], f"{name}: overlapping texts {lay['overlaps'][:5]}"
+
+
+@pytest.mark.slow
+@pytest.mark.pipeline
+@needs_chromium
+@pytest.mark.parametrize("name", PAGES)
+def test_page_figure_fonts_at_page_width(results, name):
+    """The smallest font of each figure saved by ncd.pages.notebook.save, at the size the page
+    shows it in a 1280 px window, is at least MIN_FONT_PT."""
+    from ncd.pages.notebook import MIN_FONT_PT
+
+    for scale, lay in page_layouts(results, name, laid_out(built_page(results, name))):
         shown = lay["min_font_pt"] * lay["dpi"] / 96 * min(scale, 1.0) if lay["min_font_pt"] else MIN_FONT_PT
         assert shown >= MIN_FONT_PT - 0.05, f"{name}: smallest font {shown:.1f} pt at the page's width"
 
