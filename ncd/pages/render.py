@@ -29,6 +29,7 @@ TITLES = {
     "fig4_pile": "Figure 4 — a pile poured from a localized source",
     "fig4_history": "Beyond the paper — Figure 4's piles from a point source and from a rain",
     "fig4_history_size": "Beyond the paper — Figure 4's piles against their size",
+    "fig4_bank": "End of §5 — the bank of the pile: surface-parallel cuts, stress and reciprocity",
     "fig5_governing": "Beyond the paper — governing parameters of indeterminacy",
     "stability": "Beyond the paper — stability on stiff and extreme cases",
     "error_vs_runtime": "Beyond the paper — error against run time",
