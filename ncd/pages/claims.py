@@ -295,8 +295,9 @@ def fig2_line(results):
     grain = int(meas.attrs["grain"])
     ratio = float(meas.ratio.sel(init="zero", tol=float(meas.tol.min()), disc=grain))
     n_sol = int(meas.attrs["n_solutions"])
-    why = ("two solutions: a line by construction, so this step cannot answer the question" if n_sol <= 2
-           else "more than two solutions on a line")
+    why = ("one solution: no dispersion to shape" if n_sol < 2 else
+           "two solutions: a line by construction, so this step cannot answer the question" if n_sol == 2
+           else "more than two solutions")
     return _v(f"grain {grain}: minor/major principal spread {ratio:.1e}; {n_sol} distinct solutions ({why})",
               BEYOND, "an open question of the paper: measured, not judged", "s3-line", "fig2_slope/measures.nc")
 
@@ -307,6 +308,10 @@ def fig2_sticking(results):
     (the census): where do they differ?  And how the difference spreads from there."""
     census = _open(results, "fig2_slope/census.nc")
     meas = _open(results, "fig2_slope/measures.nc")
+    if census.sizes["solution"] < 2 or "switch_distance" not in meas:
+        return _v(f"the census finds {census.sizes['solution']} exact solution(s) at this step: no contact where "
+                  "solutions differ", DIFFERS, "a \"may\": most contacts where the solutions differ stick in one "
+                  "of them", "s3-sticking-determinant", "fig2_slope/census.nc")
     st = census.status.values[:, census.switching.values]
     stick = int(st.shape[0] and np.sum((st == 1).any(0)))
     n_sw = st.shape[1]
