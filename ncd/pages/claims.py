@@ -310,7 +310,7 @@ def fig2_sticking(results):
     meas = _open(results, "fig2_slope/measures.nc")
     if census.sizes["solution"] < 2 or "switch_distance" not in meas:
         return _v(f"the census finds {census.sizes['solution']} exact solution(s) at this step: no contact where "
-                  "solutions differ", DIFFERS, "a \"may\": most contacts where the solutions differ stick in one "
+                  "solutions differ", NOT_COMPUTED, "a \"may\": most contacts where the solutions differ stick in one "
                   "of them", "s3-sticking-determinant", "fig2_slope/census.nc")
     st = census.status.values[:, census.switching.values]
     stick = int(st.shape[0] and np.sum((st == 1).any(0)))
