@@ -14,7 +14,7 @@ import numpy as np
 import xarray as xr
 from scipy import stats
 
-from ncd.core.verdict import DIFFERS, NOT_COMPUTED, REPRODUCED, Verdict
+from ncd.core.verdict import DIFFERS, NOT_COMPUTED, NOT_TESTED, REPRODUCED, Verdict
 from ncd.figures.governing import eta_table, mixed_only
 from ncd.figures.governing_unger import eta_u
 
@@ -54,7 +54,7 @@ def small_mu_slope(ds, var="eta_walk", kind=0, points=3):
 def vanishing(ds, var="eta_walk", kind=0):
     """``(mu_min, mean eta at mu_min / largest mean eta)``: small when eta -> 0 as mu -> 0."""
     t = eta_table(ds, var, kind)
-    if not np.isfinite(t[:, 1]).any():
+    if not (np.nan_to_num(t[:, 1]) > 0).any():
         return np.nan, np.nan
     return float(t[0, 0]), float(t[0, 1] / np.nanmax(t[:, 1]))
 
@@ -103,12 +103,22 @@ def _missing():
     return Verdict("packings.nc not computed", NOT_COMPUTED, "", "unger-peak", (DATA,))
 
 
+def _flat(ds, kind, anchor):
+    """None, or the verdict of a series whose every slice is determinate (nothing to compare)."""
+    if (np.nan_to_num(ds.eta_walk.values[ds.kind.values == kind]) > 0).any():
+        return None
+    return Verdict("every analysed slice of this series is determinate (dim(A ∩ C) = 0, η_U = 0): no curve to "
+                   "compare in this run", NOT_TESTED, "needs indeterminate slices", anchor, (DATA,))
+
+
 def claim_unger_peak(results):
     """eta_U peaks near mu = 0.1: the peak's bootstrap band over packings contains the
     grid point nearest 0.1, and the peak is not at an end of the grid."""
     ds = _open(results)
     if ds is None:
         return _missing()
+    if (flat := _flat(ds, 0, "unger-peak")) is not None:
+        return flat
     m, lo, hi = peak(ds)
     grid = np.unique(ds.mu.values)
     near = grid[np.argmin(np.abs(np.log(grid / PEAK_MU)))]
@@ -126,6 +136,8 @@ def claim_unger_vanishes(results):
     ds = _open(results)
     if ds is None:
         return _missing()
+    if (flat := _flat(ds, 0, "unger-vanishes")) is not None:
+        return flat
     mu0, ratio = vanishing(ds)
     slope = small_mu_slope(ds)
     z0 = eta_table(ds, "z", 0)[0, 1]
@@ -142,6 +154,8 @@ def claim_unger_control(results):
     ds = _open(results)
     if ds is None or not (ds.kind.values == 1).any():
         return _missing()
+    if (flat := _flat(ds, 1, "unger-control")) is not None:
+        return flat
     rho, falls = control_trend(ds)
     rho_u, falls_u = control_trend(ds, "eta_uniform")
     ok = rho >= 0.9 and falls == 0
@@ -157,7 +171,10 @@ def claim_unger_centrality(results):
     if ds is None:
         return _missing()
     n, closer, rank = centrality_summary(ds)
-    ok = n > 0 and closer >= 0.8 * n
+    if n == 0:
+        return Verdict("no indeterminate built-at-μ slice whose uniform chains agree in this run", NOT_TESTED,
+                       "needs a mixed uniform sample of an indeterminate slice", "unger-centrality", (DATA,))
+    ok = closer >= 0.8 * n
     return Verdict(f"history state closer to the centre than the mean uniform sample in {closer} of {n} "
                    f"indeterminate packings (median fraction of uniform samples closer than it: {rank:.2f})",
                    REPRODUCED if ok else DIFFERS, "closer in at least 80 % of the packings with dim(A ∩ C) > 0",
