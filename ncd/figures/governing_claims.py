@@ -158,6 +158,9 @@ def claim_unger_control(results):
         return flat
     rho, falls = control_trend(ds)
     rho_u, falls_u = control_trend(ds, "eta_uniform")
+    if not np.isfinite(rho):
+        return Verdict("fewer than 3 values of μ with a walk that moved in the control series", NOT_TESTED,
+                       "needs η_U of the walk at 3 values of μ or more", "unger-control", (DATA,))
     ok = rho >= 0.9 and falls == 0
     return Verdict(f"control series: Spearman ρ(μ, η_U) = {rho:.2f} on the walk ({falls} falls between "
                    f"neighbouring μ), {rho_u:.2f} on the uniform sample ({falls_u} falls)",
