@@ -60,7 +60,6 @@ import numpy as np
 import xarray as xr
 from IPython.display import Markdown, display
 
-from ncd.figures import governing as fg
 from ncd.figures import governing_claims as gc
 from ncd.figures import governing_plot as gp
 from ncd.figures import governing_summary as gs
@@ -76,26 +75,8 @@ results = Path(inp.packings).parents[1]           # the results folder the claim
 # ## The packings
 
 # %%
-p, w, u = cfg["packings"], cfg["walk"], cfg["uniform"]
 plates = ds.kind.values == 0
-dim = ds.dim_AC_rank.values
-display(Markdown(
-    f"{ds.sizes['build']} packings of N = {p['n_discs']} discs, width {p['width_radii']} R, built by contact "
-    f"dynamics in {int(ds.build_steps.min())}–{int(ds.build_steps.max())} steps of h = {p['h']:g} s (largest "
-    f"interpenetration {float(ds.max_penetration.max()):.3f} R; every one passed the test from rest, "
-    f"largest |u_f| = {float(ds.rest_velocity.max()):.1e} load h): {p['per_mu']} at each of {p['n_mu']} values of "
-    f"μ from {p['mu_min']:g} to {p['mu_max']:g}, and {p['control']} frictionless (the control series, analysed "
-    f"at every μ). The middle slice of {p['slice_radii']} R holds {int(ds.n_slice.min())}–{int(ds.n_slice.max())} "
-    f"discs and {int(ds.n_contacts.min())}–{int(ds.n_contacts.max())} contacts; dim(A∩C) is "
-    f"{int(dim.min())}–{int(dim.max())} (rank count and LP agree on {int((ds.dim_AC_lp == ds.dim_AC_rank).sum())} "
-    f"of {ds.sizes['packing']} analyses); the slice's A ∩ C is bounded in {int(ds.bounded.sum())} and the whole "
-    f"cell's in {int(ds.bounded_cell.sum())} of them. Random walk: {w['samples']} rounds per analysis, "
-    f"{int(ds.walk_ok.sum() - ds.sizes['packing'])} of {w['samples'] * ds.sizes['packing']} relaxed states points "
-    f"of A ∩ C (a failed round leaves the walk in place). Uniform sample: 2 chains × {u['per_chain']} points "
-    f"from dispersed starts; they agree (η_U within {fg.MIXED_GAP:.0%}, R-hat ≤ {fg.MIXED_RHAT}) on "
-    f"{int(ds.mixed.sum())} of {int(ds.bounded.sum())} analyses; the others (at μ = "
-    f"{', '.join(f'{m:.3g}' for m in ds.mu.values[ds.mixed.values == 0]) or 'none'}) are left out of every "
-    "uniform-sample number below and in the figure."))
+display(Markdown(gc.study_summary(ds, cfg)))
 
 # %%
 med, worst, n_w = gc.walk_settling(ds)
