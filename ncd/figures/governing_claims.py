@@ -165,6 +165,10 @@ def claim_unger_vanishes(results):
     mu0, ratio = vanishing(ds)
     slope = small_mu_slope(ds)
     z0 = eta_table(ds, "z", 0)[0, 1]
+    if not np.isfinite(slope):
+        return Verdict(f"fewer than two μ with η_U > 0 at the small-μ end (η_U at μ = {mu0:.3g} is {ratio:.2g} of "
+                       f"its largest value; z = {z0:.2f} there)", NOT_TESTED, "needs a small-μ slope",
+                       "unger-vanishes", (DATA,))
     ok = ratio < 0.05 and 0.5 <= slope <= 1.5 and abs(z0 - Z_ISOSTATIC) <= 0.3
     return Verdict(f"at μ = {mu0:.3g} η_U is {ratio:.2g} of its largest value; log-log slope over the smallest μ "
                    f"{slope:.2f}; z = {z0:.2f} there (isostatic frictionless: 4)",
