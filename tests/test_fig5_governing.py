@@ -53,7 +53,7 @@ def small_plates(**kw):
     return p
 
 
-WALK = dict(samples=6, noise=1.0, point_tol=1e-8,
+WALK = dict(samples=6, noise=1.0, point_tol=1e-12,
             solver=dict(tol=1e-8, max_sweeps=20000, check_every=10, finish="active_set", finish_tol=1e-12))
 
 
