@@ -85,7 +85,7 @@ def test_frictionless_packing_is_isostatic_and_determinate(frictionless_cell):
     dim (A ∩ C) = 0, every contact fixed, eta_U = 0 on the uniform sample (one point) and on
     the random walk (every relaxation returns the history state to round-off)."""
     p, cell, forces, contacts, _ = frictionless_cell
-    sl = fg.slice_of(cell, contacts, forces, p)
+    sl = fg.slice_of(cell, contacts, fg.exact_rest(cell, contacts, forces, 0.0), p)
     assert len(sl.mu) >= 5 and (sl.mu == 0).all()
     m = ge.exact_measures(sl.H, sl.F, sl.mu, feas_tol=1e-9)
     assert (m["dim_AC_rank"], m["dim_AC_lp"]) == (0, 0) and m["n_fixed"] == m["n_contacts"]
