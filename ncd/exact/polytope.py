@@ -308,6 +308,6 @@ def _rhat(x):
     m, n, _ = x.shape
     W = x.var(axis=1, ddof=1).mean(0)
     B = n * x.mean(1).var(axis=0, ddof=1)
-    ok = W > 1e-30 * max(W.max(), 1e-300)
+    ok = W > 1e-12 * max(W.max(), 1e-300)      # a variance at round-off level is no coordinate to mix
     var = (n - 1) / n * W[ok] + B[ok] / n
     return float(np.sqrt(var / W[ok]).max()) if ok.any() else 1.0

@@ -216,13 +216,18 @@ def cell_of(builds, j, cfg, mu):
         raise ValueError(f"build {int(builds.build[j])}: the contacts found again differ from those stored")
     k = len(keys)
     f = np.column_stack([builds.rest_force_n[j].values[:k], builds.rest_force_t[j].values[:k]])
-    # the rest test's forces (|H r + F| up to ~1e-9 of the load) made exact on their active
-    # Coulomb rows at the build's friction: the slice's loads are then consistent to round-off
-    mu_b = np.where(contacts.body_b == cell.n, 0.0, float(builds.build_mu[j]))
-    f = ExactSet(h_matrix(cell.scene, contacts), plates.external_force(cell), mu_b).refine(f.ravel()).reshape(k, 2)
+    f = exact_rest(cell, contacts, f, float(builds.build_mu[j]))
     if mu == 0.0 or float(builds.build_mu[j]) != mu:
         contacts.mu[:] = np.where(contacts.body_b == cell.n, 0.0, float(mu))    # plate contacts stay frictionless
     return cell, contacts, f
+
+
+def exact_rest(cell, contacts, forces, build_mu):
+    """The rest test's forces (``|H r + F|`` up to ~1e-9 of the load) made exact on their active
+    Coulomb rows at the build's friction: a slice's loads are then consistent to round-off."""
+    mu_b = np.where(contacts.body_b == cell.n, 0.0, float(build_mu))
+    es = ExactSet(h_matrix(cell.scene, contacts), plates.external_force(cell), mu_b)
+    return es.refine(np.asarray(forces).ravel()).reshape(-1, 2)
 
 
 def slice_of(cell, contacts, forces, p):
@@ -406,5 +411,5 @@ def eta_table(ds, var="eta_walk", kind=0):
 
 
 __all__ = ["KINDS", "mu_values", "build_table", "analysis_table", "ballistic", "initial_cell", "build",
-           "pack_shard", "cell_of", "slice_of", "coordination", "analyse", "plates_bounded", "analysis_shard",
+           "pack_shard", "cell_of", "exact_rest", "slice_of", "coordination", "analyse", "plates_bounded", "analysis_shard",
            "merge", "builds_of", "mixed_only", "eta_table", "SCALARS", "MIXED_GAP", "MIXED_RHAT"]

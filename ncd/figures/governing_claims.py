@@ -14,8 +14,8 @@ import numpy as np
 import xarray as xr
 from scipy import stats
 
-from ncd.core.verdict import DIFFERS, NOT_COMPUTED, REPRODUCED, Verdict
-from ncd.figures.governing import eta_table, mixed_only
+from ncd.core.verdict import DIFFERS, NOT_COMPUTED, NOT_TESTED, REPRODUCED, Verdict
+from ncd.figures.governing import MIXED_GAP, MIXED_RHAT, eta_table, mixed_only
 from ncd.figures.governing_unger import eta_u
 
 DATA = "fig5_governing/packings.nc"
@@ -54,7 +54,7 @@ def small_mu_slope(ds, var="eta_walk", kind=0, points=3):
 def vanishing(ds, var="eta_walk", kind=0):
     """``(mu_min, mean eta at mu_min / largest mean eta)``: small when eta -> 0 as mu -> 0."""
     t = eta_table(ds, var, kind)
-    if not np.isfinite(t[:, 1]).any():
+    if not (np.nan_to_num(t[:, 1]) > 0).any():
         return np.nan, np.nan
     return float(t[0, 0]), float(t[0, 1] / np.nanmax(t[:, 1]))
 
@@ -94,6 +94,30 @@ def walk_settling(ds):
     return (float(np.median(out)), float(np.max(out)), len(out)) if out else (np.nan, np.nan, 0)
 
 
+def study_summary(ds, cfg):
+    """One paragraph of the study's numbers: packings, slices, dimensions, boundedness, walk
+    and uniform-sample acceptance (the page's first measured paragraph)."""
+    p, w, u = cfg["packings"], cfg["walk"], cfg["uniform"]
+    dim = ds.dim_AC_rank.values
+    others = ", ".join(f"{m:.3g}" for m in ds.mu.values[ds.mixed.values == 0]) or "none"
+    return (
+        f"{ds.sizes['build']} packings of N = {p['n_discs']} discs, width {p['width_radii']} R, built by contact "
+        f"dynamics in {int(ds.build_steps.min())}–{int(ds.build_steps.max())} steps of h = {p['h']:g} s (largest "
+        f"interpenetration {float(ds.max_penetration.max()):.3f} R; every one passed the test from rest, largest "
+        f"|u_f| = {float(ds.rest_velocity.max()):.1e} load h): {p['per_mu']} at each of {p['n_mu']} values of μ "
+        f"from {p['mu_min']:g} to {p['mu_max']:g}, and {p['control']} frictionless (the control series, analysed at "
+        f"every μ). The middle slice of {p['slice_radii']} R holds {int(ds.n_slice.min())}–{int(ds.n_slice.max())} "
+        f"discs and {int(ds.n_contacts.min())}–{int(ds.n_contacts.max())} contacts; dim(A∩C) is "
+        f"{int(dim.min())}–{int(dim.max())} (rank count and LP agree on {int((ds.dim_AC_lp == ds.dim_AC_rank).sum())} "
+        f"of {ds.sizes['packing']} analyses); the slice's A ∩ C is bounded in {int(ds.bounded.sum())} and the whole "
+        f"cell's in {int(ds.bounded_cell.sum())} of them. Random walk: {w['samples']} rounds per analysis, "
+        f"{int(ds.walk_ok.sum() - ds.sizes['packing'])} of {w['samples'] * ds.sizes['packing']} relaxed states "
+        f"points of A ∩ C (a failed round leaves the walk in place). Uniform sample: 2 chains × {u['per_chain']} "
+        f"points from dispersed starts; they agree (η_U within {MIXED_GAP:.0%}, R-hat ≤ {MIXED_RHAT}) on "
+        f"{int(ds.mixed.sum())} of {int(ds.bounded.sum())} analyses; the others (at μ = {others}) are left out of "
+        "every uniform-sample number below and in the figure.")
+
+
 def _open(results):
     path = Path(results) / DATA
     return mixed_only(xr.load_dataset(path)) if path.exists() else None
@@ -103,12 +127,22 @@ def _missing():
     return Verdict("packings.nc not computed", NOT_COMPUTED, "", "unger-peak", (DATA,))
 
 
+def _flat(ds, kind, anchor):
+    """None, or the verdict of a series whose every slice is determinate (nothing to compare)."""
+    if (np.nan_to_num(ds.eta_walk.values[ds.kind.values == kind]) > 0).any():
+        return None
+    return Verdict("every analysed slice of this series is determinate (dim(A ∩ C) = 0, η_U = 0): no curve to "
+                   "compare in this run", NOT_TESTED, "needs indeterminate slices", anchor, (DATA,))
+
+
 def claim_unger_peak(results):
     """eta_U peaks near mu = 0.1: the peak's bootstrap band over packings contains the
     grid point nearest 0.1, and the peak is not at an end of the grid."""
     ds = _open(results)
     if ds is None:
         return _missing()
+    if (flat := _flat(ds, 0, "unger-peak")) is not None:
+        return flat
     m, lo, hi = peak(ds)
     grid = np.unique(ds.mu.values)
     near = grid[np.argmin(np.abs(np.log(grid / PEAK_MU)))]
@@ -126,9 +160,15 @@ def claim_unger_vanishes(results):
     ds = _open(results)
     if ds is None:
         return _missing()
+    if (flat := _flat(ds, 0, "unger-vanishes")) is not None:
+        return flat
     mu0, ratio = vanishing(ds)
     slope = small_mu_slope(ds)
     z0 = eta_table(ds, "z", 0)[0, 1]
+    if not np.isfinite(slope):
+        return Verdict(f"fewer than two μ with η_U > 0 at the small-μ end (η_U at μ = {mu0:.3g} is {ratio:.2g} of "
+                       f"its largest value; z = {z0:.2f} there)", NOT_TESTED, "needs a small-μ slope",
+                       "unger-vanishes", (DATA,))
     ok = ratio < 0.05 and 0.5 <= slope <= 1.5 and abs(z0 - Z_ISOSTATIC) <= 0.3
     return Verdict(f"at μ = {mu0:.3g} η_U is {ratio:.2g} of its largest value; log-log slope over the smallest μ "
                    f"{slope:.2f}; z = {z0:.2f} there (isostatic frictionless: 4)",
@@ -142,8 +182,13 @@ def claim_unger_control(results):
     ds = _open(results)
     if ds is None or not (ds.kind.values == 1).any():
         return _missing()
+    if (flat := _flat(ds, 1, "unger-control")) is not None:
+        return flat
     rho, falls = control_trend(ds)
     rho_u, falls_u = control_trend(ds, "eta_uniform")
+    if not np.isfinite(rho):
+        return Verdict("fewer than 3 values of μ with a walk that moved in the control series", NOT_TESTED,
+                       "needs η_U of the walk at 3 values of μ or more", "unger-control", (DATA,))
     ok = rho >= 0.9 and falls == 0
     return Verdict(f"control series: Spearman ρ(μ, η_U) = {rho:.2f} on the walk ({falls} falls between "
                    f"neighbouring μ), {rho_u:.2f} on the uniform sample ({falls_u} falls)",
@@ -157,12 +202,15 @@ def claim_unger_centrality(results):
     if ds is None:
         return _missing()
     n, closer, rank = centrality_summary(ds)
-    ok = n > 0 and closer >= 0.8 * n
+    if n == 0:
+        return Verdict("no indeterminate built-at-μ slice whose uniform chains agree in this run", NOT_TESTED,
+                       "needs a mixed uniform sample of an indeterminate slice", "unger-centrality", (DATA,))
+    ok = closer >= 0.8 * n
     return Verdict(f"history state closer to the centre than the mean uniform sample in {closer} of {n} "
                    f"indeterminate packings (median fraction of uniform samples closer than it: {rank:.2f})",
                    REPRODUCED if ok else DIFFERS, "closer in at least 80 % of the packings with dim(A ∩ C) > 0",
                    "unger-centrality", (DATA,))
 
 
-__all__ = ["walk_settling", "peak", "small_mu_slope", "vanishing", "control_trend", "centrality_summary", "claim_unger_peak",
+__all__ = ["study_summary", "walk_settling", "peak", "small_mu_slope", "vanishing", "control_trend", "centrality_summary", "claim_unger_peak",
            "claim_unger_vanishes", "claim_unger_control", "claim_unger_centrality", "PEAK_MU", "Z_ISOSTATIC"]

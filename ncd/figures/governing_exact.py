@@ -6,7 +6,8 @@ every force component over ``A ∩ C`` by HiGHS LPs on one model (:func:`force_r
 the implicit equalities and ``dim (A ∩ C)`` by a rank count, checked against the affine
 rank of LP points (:func:`lp_dimension`); the contacts fixed by statics; boundedness (a
 self-stress inside ``C`` gives infinite ranges, reported as NaN); and the exact
-indeterminacy ratio ``eta_exact`` (range widths over the mean force at the range centres).
+range ratio ``eta_exact`` (range-box diagonals over the forces at the box centres: the full extent
+of the set along each contact, not Unger et al.'s eta_U, a standard deviation).
 """
 import highspy
 import numpy as np

@@ -19,7 +19,7 @@ SERIES = {"eta_walk": ("η_U, their random walk", "C0", "o"),
 
 
 def _legend(ax, ncol=1):
-    ax.legend(fontsize=9, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=ncol, frameon=False)
+    ax.legend(fontsize=11, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=ncol, frameon=False)
 
 
 def _log_or_empty(ax, has_data, axes="xy"):
@@ -29,7 +29,7 @@ def _log_or_empty(ax, has_data, axes="xy"):
         for a in axes:
             getattr(ax, f"set_{a}scale")("log")
     else:
-        ax.text(0.5, 0.5, "no non-zero value in this run", transform=ax.transAxes, ha="center", fontsize=10)
+        ax.text(0.5, 0.5, "no non-zero value in this run", transform=ax.transAxes, ha="center")
 
 
 def _band(ax, table, label, color, marker="o", ls="-"):
@@ -135,7 +135,7 @@ def panel_flows(ax, flows, factor, letter):
         tw.errorbar(sp[ok, 0], sp[ok, 1], yerr=[low, half], marker="s", color="C3", capsize=3)
         tw.set_yscale("log")
         ax.plot([], [], "s-", color="C3", label="mean largest spread / |g| (right axis)")
-    tw.tick_params(axis="y", labelsize=9, colors="C3")
+    tw.tick_params(axis="y", labelsize=11, colors="C3")
     _legend(ax)
 
 
@@ -154,9 +154,14 @@ def panel_line(ax, flows, letter):
 
 
 def figure(ds, flows=None):
-    """The whole figure: packings (a-f) and, with ``flows``, the flow study (g-j)."""
-    ds = mixed_only(ds)           # the uniform sample's measures where its two chains agree
-    fig = plt.figure(figsize=(17, 15 if flows is not None else 10), layout="constrained")
+    """The whole figure: packings (a-f) and, with ``flows``, the flow study (g-j); fonts of
+    12 pt on a 16-inch figure stay near 9 pt when the page shrinks it to its width."""
+    with plt.rc_context({"font.size": 12, "axes.titlesize": 13, "axes.labelsize": 12}):
+        return _figure(mixed_only(ds), flows)     # uniform-sample measures where its chains agree
+
+
+def _figure(ds, flows):
+    fig = plt.figure(figsize=(16, 16 if flows is not None else 10.5), layout="constrained")
     subs = fig.subfigures(2 if flows is not None else 1, 1, height_ratios=[2, 1] if flows is not None else None,
                           squeeze=False)[:, 0]
     top = subs[0].subplots(2, 3)
@@ -174,7 +179,7 @@ def figure(ds, flows=None):
     for ax in fig.axes:             # log axes: labelled decades only (minor labels collide)
         if ax.get_xscale() == "log":
             ax.xaxis.set_minor_formatter(plt.NullFormatter())
-    fig.suptitle(TITLE, fontsize=14)
+    fig.suptitle(TITLE, fontsize=16)
     return fig
 
 
