@@ -1,9 +1,17 @@
 """Figure 2: the census of the exact solutions of the investigated step (census.nc)."""
-import xarray as xr
+import os
 
-from ncd.figures import census
-from ncd.io.netcdf import write_dataset
-from ncd.pipeline.workflow import start
+# One BLAS thread whatever the rule's threads (Snakemake sets OPENBLAS_NUM_THREADS to them),
+# set before numpy loads: the dense solves of Lemke's bases keep the same bits whatever -j,
+# and the rule's threads run the census's independent solves side by side instead.
+for _var in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ[_var] = "1"
+
+import xarray as xr  # noqa: E402 (after the BLAS thread count)
+
+from ncd.figures import census  # noqa: E402
+from ncd.io.netcdf import write_dataset  # noqa: E402
+from ncd.pipeline.workflow import start  # noqa: E402
 
 log = start(snakemake)  # noqa: F821 (snakemake is injected)
 inp = snakemake.input  # noqa: F821
