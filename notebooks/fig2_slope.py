@@ -92,7 +92,6 @@ display(HTML(page.tolerance_table(ens, meas).to_html(index=False)))
 display(Markdown(claim_markdown("s3-dispersion", results, "fig2_slope")))
 display(Markdown(claim_markdown("s3-warm-no-dispersion", results, "fig2_slope")))
 display(Markdown(claim_markdown("s2-warm-little-indeterminacy", results, "fig2_slope")))
-display(Markdown(claim_markdown("s2-warm-accelerates", results, "fig2_slope")))
 
 # %%
 display(Markdown(sa.warm_check(ens, cfg["analysis"]["solution_threshold"]) or "The warm runs are plain NLGS."))
