@@ -354,3 +354,30 @@ def test_save_records_the_layout_in_the_png(tmp_path):
     assert lay["dpi"] == 150 and lay["overlaps"] == [] and lay["width_in"] == 4 and fig.dpi == 72
     assert lay["min_font_pt"] == min(11, ax.xaxis.get_ticklabels()[0].get_fontsize())
     plt.close(fig)
+
+
+def test_layout_skips_undrawn_ticks_of_an_inset_colorbar():
+    """A colorbar in an inset axes (outside ``fig.axes``) keeps the labels of log ticks below
+    its range, which it does not draw; the layout leaves them out like those of any axes, so
+    they make no false overlap with the panel under the colorbar."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.colors import LogNorm
+
+    from ncd.pages.notebook import drawn_texts, text_layout
+
+    fig, (top, bottom) = plt.subplots(2, 1, figsize=(5, 5), dpi=100, layout="constrained")
+    sm = plt.cm.ScalarMappable(norm=LogNorm(vmin=9.8e-4, vmax=8e-3), cmap="viridis")
+    cax = top.inset_axes([1.02, 0.06, 0.04, 0.88])
+    fig.colorbar(sm, cax=cax)
+    bottom.set_title("(b) below")
+    texts = drawn_texts(fig)
+    renderer = fig.canvas.get_renderer()
+    bar = cax.get_window_extent(renderer)
+    beside = [t.get_window_extent(renderer) for t in texts if t.get_window_extent(renderer).x0 >= bar.x1]
+    assert beside, "no label of the colorbar found"
+    assert all(bar.y0 - 1 <= 0.5 * (b.y0 + b.y1) <= bar.y1 + 1 for b in beside), "a label outside the colorbar"
+    assert text_layout(fig)["overlaps"] == []
+    plt.close(fig)

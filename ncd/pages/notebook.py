@@ -86,12 +86,14 @@ def write_finding(output, text):
 
 def drawn_texts(fig):
     """The texts a draw of ``fig`` shows: visible, non-empty, and for tick labels only the
-    ticks inside their axis's view (matplotlib keeps labels of ticks it does not draw)."""
+    ticks inside their axis's view (matplotlib keeps labels of ticks it does not draw), the
+    ticks of inset axes (a colorbar's ``cax``, outside ``fig.axes``) included."""
+    from matplotlib.axes import Axes
     from matplotlib.text import Text
 
     fig.canvas.draw()
     ticks, shown = set(), []
-    for ax in fig.axes:
+    for ax in fig.findobj(Axes):
         for axis in (ax.xaxis, ax.yaxis):
             lo, hi = sorted(axis.get_view_interval())
             pad = 1e-9 * max(abs(lo), abs(hi), 1.0)
