@@ -152,61 +152,13 @@ display(Markdown(
 # ## Flows: indeterminate steps against friction, time step and slope
 
 # %%
-fc = cfg["flows"]
-fm = gs.flow_measures(flows)
-n_set = len(np.unique(flows.setting.values))
-runs = fc["scan"]["runs"]
-n_scan = flows.sizes["scan"]
-ind = flows.indeterminate.values
-conv = (flows.converged_zero.values + flows.converged_warm.values).sum()
-display(Markdown(
-    f"{flows.sizes['flow']} flows: {n_set} settings × {fc['seeds']} seeds, one factor at a time around "
-    f"μ = {fc['base']['mu']}, h = {fc['base']['h']:g} s, slope {fc['base']['slope_deg']:g}°. "
-    f"Each flow is scanned {n_scan} times, every {fc['scan_every'] * 1e3:g} ms up to "
-    f"{fc['duration'] * 1e3:g} ms after release, with {runs} zero-guess and {runs} warm-start runs: "
-    f"{conv} of {2 * runs * ind.size} runs converged. Of the {ind.size} scanned steps, "
-    f"{int((ind == 1).sum())} are indeterminate (two exact solutions or more), {int((ind == 0).sum())} "
-    f"determinate and {int((ind == -1).sum())} unknown (no converged run, or end points that did not "
-    f"polish to exact solutions: {int(((ind == -1) & (flows.n_solutions.values == 0)).sum())} without a "
-    f"converged run). With {runs} + {runs} runs per step a solution reached rarely can be missed: the "
-    f"fractions below are lower bounds of the fraction of steps with several solutions."))
+display(Markdown(gs.flows_overview(flows, cfg["flows"])))
 
 # %%
-rows = []
-for factor, name, unit in (("mu", "μ", ""), ("h", "h", " s"), ("slope", "slope", "°")):
-    ti, ts = gs.factor_table(flows, factor, "indeterminate"), gs.factor_table(flows, factor, "spread")
-    tu = gs.factor_table(flows, factor, "unknown")
-    cells = "; ".join(f"{name} = {v:g}{unit}: {m:.2f} ± {np.nan_to_num(b):.2f} (spread {s:.2g} |g|, "
-                      f"unknown {u:.2f}, {int(n)} flows)"
-                      for (v, m, b, n), (_, s, _, _), (_, u, _, _) in zip(ti, ts, tu))
-    rows.append(f"**Against {name}** — fraction of indeterminate steps (mean ± 95 % band over seeds): {cells}.")
-display(Markdown("\n\n".join(rows)))
+display(Markdown(gs.factor_text(flows)))
 
 # %% [markdown]
 # ## Why a line
 
 # %%
-c = gs.line_counts(flows)
-ratio = flows.cloud_minor.values / flows.cloud_major.values
-lr = fc["line_ratio"]
-visual = int(((flows.indeterminate.values == 1) & (ratio <= lr)).sum())
-display(Markdown(
-    f"At the {c['steps']} indeterminate steps: {c['solutions'][0]} have two exact solutions, "
-    f"{c['solutions'][1]} three and {c['solutions'][2]} more; a median of {c['switched_median']:.0f} "
-    f"contacts change status and {c['moving_median']:.0f} grains accelerate differently between them "
-    f"(one connected cluster at {c['one_cluster']} steps). The cloud of the grain of largest spread is a "
-    f"point at {c['rank'][0]}, a line (rank 1, minor extent below the solution threshold) at {c['rank'][1]} "
-    f"and spans an area at {c['rank'][2]} steps; by Figure 2's visual criterion (minor/major ≤ {lr}) it "
-    f"is a line at {visual}. The grain's cluster has one degree of freedom (the solutions restricted to "
-    f"it span one direction) at {c['predicted']} steps; the hypothesis — a line exactly when one isolated "
-    f"one-degree-of-freedom cluster decides between the solutions — holds at {c['holds']} of "
-    f"{c['steps']} steps ({c['line_and_predicted']} lines predicted, {c['line_not_predicted']} lines "
-    f"not predicted). Two solutions always span one direction: with two exact solutions the line is "
-    f"unavoidable, and the test has content only at the {c['tested']['steps']} steps with three or more. "
-    f"There it holds at {c['tested']['holds']}: {c['tested']['line_and_predicted']} predicted lines and "
-    f"{c['tested']['neither']} steps with neither a line nor a prediction; it fails at "
-    f"{c['tested']['line_not_predicted']} lines not predicted and {c['tested']['predicted_not_line']} "
-    f"predicted lines that are not. Keeping the statuses "
-    f"of the most frequent solution leaves grain velocities free (a continuum of solutions) at "
-    f"{c['continuum']} steps; elsewhere the solutions are isolated points and the impulses alone are "
-    f"indeterminate (median dimension {np.nanmedian(flows.null_impulse.values[flows.indeterminate.values == 1]) if c['steps'] else np.nan:.0f})."))
+display(Markdown(gs.line_text(flows, cfg["flows"]["line_ratio"])))
