@@ -107,7 +107,7 @@ def test_notebook_narrates_and_the_package_computes(py):
 
 
 # pages rewritten as paper sections: analysis and plots in the package, a few lines per cell
-SECTION_PAGES = ("fig1_wedged", "fig2_slope", "stability", "error_vs_runtime")
+SECTION_PAGES = ("fig1_wedged", "fig2_slope", "stability", "error_vs_runtime", "bench")
 
 
 @pytest.mark.parametrize("name", SECTION_PAGES)

@@ -165,6 +165,7 @@ rule bench_notebook:
         dag="results/bench/dag.nc",
         notebook=notebook_file("bench"),
         notebook_py=notebook_file("bench", "py"),
+        page=page_modules(FIGB),
         pages=page_sources("notebook"),
     output:
         png=figure_output("bench", "png"),

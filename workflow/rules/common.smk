@@ -48,7 +48,7 @@ NCD_CORE = sorted([str(REL / "ncd" / "__init__.py")]
 STUDY_MODULES = {
     "stability": ("stability.py", "scenes.py", "stability_page.py"),
     "error_vs_runtime": ("work_precision.py", "scenes.py", "work_precision_page.py"),
-    "bench": ("bench.py", "peer.py", "finish_bench.py", "c_sweep.c"),
+    "bench": ("bench.py", "peer.py", "finish_bench.py", "c_sweep.c", "bench_page.py"),
 }
 # the page modules a page rule reads (notebook helpers, the HTML renderer, the index page)
 # (a figure's page and the index print the claims of ncd/pages/claims.py: both read it)
