@@ -63,6 +63,7 @@ from IPython.display import Markdown, display
 from ncd.figures import governing_claims as gc
 from ncd.figures import governing_plot as gp
 from ncd.figures import governing_summary as gs
+from ncd.pages.claims import claim_markdown
 from ncd.pages.notebook import paths, save
 
 _smk = paths("fig5_governing", ["packings", "flows"], globals().get("snakemake"))
@@ -156,9 +157,12 @@ display(Markdown(gs.flows_overview(flows, cfg["flows"])))
 
 # %%
 display(Markdown(gs.factor_text(flows)))
+for claim_id in ("s3-other-experiments", "s3-governing-parameters"):
+    display(Markdown(claim_markdown(claim_id, results, "fig5_governing")))
 
 # %% [markdown]
 # ## Why a line
 
 # %%
 display(Markdown(gs.line_text(flows, cfg["flows"]["line_ratio"])))
+display(Markdown(claim_markdown("s3-line", results, "fig5_governing")))

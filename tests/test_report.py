@@ -150,7 +150,11 @@ def test_each_page_states_the_index_verdict(results):
         if at < 0:
             wrong.append((c["id"], fig, f"no anchor {v.anchor}"))
             continue
-        end = text.find('<a id="', at + 10)
+        end = at
+        while True:        # the block runs to the next anchor that is not this claim's own
+            end = text.find('<a id="', end + 10)
+            if end < 0 or not text.startswith((f'<a id="{C.anchor(c["id"])}"', f'<a id="{v.anchor}"'), end):
+                break
         block = html_lib.unescape(re.sub(r"<[^>]+>", "", text[at:end if end > 0 else at + 20000]))
         if v.verdict not in block or v.value[:60] not in block:
             wrong.append((c["id"], fig, v.verdict))

@@ -14,7 +14,7 @@ from ncd.figures.bank import HISTORY_LABELS
 from ncd.scenes import stress as st
 
 COLORS = {"default": "k", "point": "C3", "rain": "C0"}
-FONT = 10
+FONT = 11
 
 
 def _histories(ms):

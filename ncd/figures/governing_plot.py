@@ -19,7 +19,7 @@ SERIES = {"eta_walk": ("η_U, their random walk", "C0", "o"),
 
 
 def _legend(ax, ncol=1):
-    ax.legend(fontsize=11, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=ncol, frameon=False)
+    ax.legend(fontsize=12, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=ncol, frameon=False)
 
 
 def _log_or_empty(ax, has_data, axes="xy"):
@@ -135,7 +135,7 @@ def panel_flows(ax, flows, factor, letter):
         tw.errorbar(sp[ok, 0], sp[ok, 1], yerr=[low, half], marker="s", color="C3", capsize=3)
         tw.set_yscale("log")
         ax.plot([], [], "s-", color="C3", label="mean largest spread / |g| (right axis)")
-    tw.tick_params(axis="y", labelsize=11, colors="C3")
+    tw.tick_params(axis="y", labelsize=12, colors="C3")
     _legend(ax)
 
 
