@@ -30,6 +30,7 @@ from ncd.figures import equilibrium as fe
 from ncd.figures import faces
 from ncd.figures import governing_claims as unger
 from ncd.figures.governing_summary import factor_table, line_counts
+from ncd.figures.pile_exact import diameter
 from ncd.solver.convergence import REST
 from ncd.studies.stability_page import inaccurate
 
@@ -460,10 +461,6 @@ def _rest_cloud(cuts, ens, k):
     return np.column_stack([ens.cut_force_x.values[rest, k], ens.cut_force_y.values[rest, k]])
 
 
-def _diameter(P):
-    return float(np.max(np.hypot(*(P[:, None] - P[None]).transpose(2, 0, 1)))) if len(P) > 1 else 0.0
-
-
 def fig4_parallel(results):
     cuts = _open(results, F4[0])
     k, _ = _default_cut(cuts)
@@ -482,7 +479,7 @@ def fig4_cloud(results):
                   "s5-cloud", F4[1])
     n = len(np.unique(np.round(P / np.abs(P).max(), 6), axis=0))
     return _v(f"{len(P)} zero-guess runs at rest give {n} distinct resultants across the default cut, spanning "
-              f"{_diameter(P):.3g} N", REPRODUCED if n > 1 else DIFFERS,
+              f"{diameter(P):.3g} N", REPRODUCED if n > 1 else DIFFERS,
               "distinct resultants over the runs at rest", "s5-cloud", F4[1])
 
 
@@ -504,7 +501,7 @@ def fig4_cut_vs_cloud(results):
     P = _rest_cloud(cuts, ens, k)
     if len(P) < 2:
         return _v(f"{len(P)} run(s) at rest: no cloud", NOT_COMPUTED, "—", "s5-cut-position", F4[1])
-    diam = _diameter(P)
+    diam = diameter(P)
     H = np.column_stack([cuts.history_fx.values, cuts.history_fy.values])
     pairs = cut_pairs(cuts)
     change = np.array([np.linalg.norm(H[i] - H[j]) for i, j in pairs])
@@ -572,8 +569,8 @@ def fig4_geometry_enough(results):
     hist = np.array([float(cuts.history_fx.values[k]), float(cuts.history_fy.values[k])])
     far = f"; the history resultant lies {np.linalg.norm(hist - P.mean(0)):.3g} N from its mean" if len(P) else ""
     exact = ex.exact.values.astype(bool)
-    return _v(f"default cut: exact set of resultants {_diameter(V):.3g} N across against a zero-guess cloud of "
-              f"{_diameter(P):.3g} N{far}; over A ∩ C the resultant's angle ranges over [{lo:.1f}°, {hi:.1f}°] below "
+    return _v(f"default cut: exact set of resultants {diameter(V):.3g} N across against a zero-guess cloud of "
+              f"{diameter(P):.3g} N{far}; over A ∩ C the resultant's angle ranges over [{lo:.1f}°, {hi:.1f}°] below "
               f"the horizontal (free surface {surf:.1f}°); every admissible state arches at "
               f"{int(ex.all_arch.values[exact].sum())} of {exact.sum()} cuts", REPRODUCED if ok else DIFFERS,
               "\"whatever is the indeterminacy\": every admissible resultant at the default cut within 10° of the "
