@@ -8,12 +8,15 @@ import json
 import re
 import shutil
 import subprocess
+from pathlib import Path
 
 import nbformat
 import pytest
 from bs4 import BeautifulSoup
 
 from ncd.pages.render import LONG_TABLE, copy_mathjax, render
+
+ROOT = Path(__file__).resolve().parent.parent
 
 CHROMIUM = next((shutil.which(c) for c in ("chromium", "chromium-browser", "google-chrome") if shutil.which(c)), None)
 needs_chromium = pytest.mark.skipif(CHROMIUM is None, reason="chromium absent (apt-get install -y chromium)")
@@ -143,8 +146,6 @@ PROBE = """<script>window.addEventListener("load", function () {
 
 def figure_order():
     """The FIGURES list of workflow/rules/common.smk (the reading order of the pages)."""
-    from tests.conftest import ROOT
-
     text = (ROOT / "workflow" / "rules" / "common.smk").read_text()
     return re.findall(r'"(\w+)"', re.search(r"FIGURES = \[f for f in \((.*?)\)", text, re.S).group(1))
 
@@ -317,8 +318,6 @@ def test_report_captions_include_the_finding(tmp_path, monkeypatch):
     figure's finding (written by the notebook from the data) renders it, as Snakemake does
     (docutils, from the working directory)."""
     from docutils.core import publish_parts
-
-    from tests.conftest import ROOT
 
     captions = sorted((ROOT / "workflow" / "report").glob("*.rst"))
     assert captions
