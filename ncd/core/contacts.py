@@ -63,14 +63,18 @@ def pair_key(body_a, body_b, n_disc):
     return key
 
 
-def detect_contacts(scene, alert=0.0, pos=None):
+def detect_contacts(scene, alert=0.0, pos=None, check=True):
     """Contacts of ``scene`` (at positions ``pos``, default its own) with gap <= alert.
 
     Disc pairs come from the O(N) grid of :mod:`ncd.core.detection`; disc-wall pairs
     from a direct test against each wall.  Contacts are sorted by body-pair key,
-    so their order does not depend on the grid.
+    so their order does not depend on the grid.  ``check=False``: the caller has
+    checked the arguments (:func:`ncd.step` does, once per step).
     """
-    pos = check_detection_args(scene, alert, pos)
+    if check:
+        pos = check_detection_args(scene, alert, pos)
+    elif pos is None:
+        pos = scene.pos
     nm = scene.n_mobile
     a, b, shift = disc_pairs(pos, scene.radius, nm, alert, scene.period)
     n_walls = len(scene.wall_point)

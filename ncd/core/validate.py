@@ -209,13 +209,14 @@ def all_finite(a):
 def finite_output(func):
     """Decorator of the NLGS entry points: a result (or, in disc form, ``vel`` and
     ``spin`` modified in place) that is not finite raises :class:`ncd.SimulationError`."""
-    signature = inspect.signature(func)
+    names = list(inspect.signature(func).parameters)
+    slots = [(names.index(k), k) for k in ("vel", "spin") if k in names]   # looked up once, not per call
 
     @functools.wraps(func)
     def checked(*args, **kwargs):
         result = func(*args, **kwargs)
-        bound = signature.bind(*args, **kwargs).arguments
-        finite_result(result, *(bound[k] for k in ("vel", "spin") if k in bound), where=func.__name__)
+        arrays = [args[i] if i < len(args) else kwargs[k] for i, k in slots]
+        finite_result(result, *arrays, where=func.__name__)
         return result
     return checked
 

@@ -78,10 +78,14 @@ def _finite(a):
 
 
 @validate.finite_problem
-def prepare_step(scene, h, theta=0.5, gap_tolerance=None, vel=None, spin=None):
-    """Build the core problem of the step from the current state (or ``vel, spin``)."""
-    check_scene(scene)
-    h, theta = check_step_args(h, theta, gap_tolerance, vel, spin, scene.n_disc)
+def prepare_step(scene, h, theta=0.5, gap_tolerance=None, vel=None, spin=None, check=True):
+    """Build the core problem of the step from the current state (or ``vel, spin``).
+
+    ``check=False``: the caller has checked the arguments (:func:`step` does, once per
+    step: the checks of a 10^3-disc step cost about a fifth of its time otherwise)."""
+    if check:
+        check_scene(scene)
+        h, theta = check_step_args(h, theta, gap_tolerance, vel, spin, scene.n_disc)
     vel = scene.vel if vel is None else vel
     spin = scene.spin if spin is None else spin
     nm = scene.n_mobile
@@ -93,7 +97,7 @@ def prepare_step(scene, h, theta=0.5, gap_tolerance=None, vel=None, spin=None):
         # a non-finite state would otherwise reach the detection grid
         raise SimulationError(f"state is non-finite at t = {scene.time:.6g} (positions, angles "
                               f"or velocities): cannot build the step")
-    contacts = detect_contacts(scene, alert=gap_tol, pos=pos_mid)
+    contacts = detect_contacts(scene, alert=gap_tol, pos=pos_mid, check=check)
     W = delassus_blocks(contacts.body_a, contacts.body_b, contacts.arm_a, contacts.arm_b,
                         scene.inv_mass, scene.inv_inertia)
     c = contacts
@@ -104,17 +108,20 @@ def prepare_step(scene, h, theta=0.5, gap_tolerance=None, vel=None, spin=None):
                        pos_mid, angle_mid, vel.copy(), spin.copy())
 
 
-def solve_problem(scene, problem, guess=None, review_order=None, settings=SolverSettings(), observe=None):
+def solve_problem(scene, problem, guess=None, review_order=None, settings=SolverSettings(), observe=None,
+                  check=True):
     """Solve a prepared step; returns ``(result, vel_f, spin_f)`` without touching the scene.
 
     ``observe(impulse, vel, spin) -> 1-D array``: the figure's observable, scaled to
     order one; NLGS then runs in chunks of ``settings.check_every`` sweeps and the run
-    is converged only when it has settled too (:mod:`ncd.solver.convergence`)."""
-    check_step_problem(scene, problem)   # guess, review_order, settings: in solve_discs
+    is converged only when it has settled too (:mod:`ncd.solver.convergence`).
+    ``check=False``: the caller has checked the arguments (as :func:`step` does)."""
+    if check:
+        check_step_problem(scene, problem)   # guess, review_order, settings: in solve_discs
     vel = problem.free_vel.copy()
     spin = problem.free_spin.copy()
     result = solve_discs(scene, problem.contacts, vel, spin, guess, review_order, settings,
-                         bias=problem.bias, W=problem.W, observe=observe)
+                         bias=problem.bias, W=problem.W, observe=observe, check=check)
     return result, vel, spin
 
 
@@ -135,9 +142,12 @@ def step(scene, h, theta=0.5, settings=SolverSettings(), init="warm", review_ord
          gap_tolerance=None, speed_limit=np.inf):
     """Advance ``scene`` by one Moreau-Jean step in place; returns a :class:`StepReport`."""
     h, theta = check_step_call(scene, h, theta, settings, init, gap_tolerance, speed_limit)
-    problem = prepare_step(scene, h, theta, gap_tolerance)
+    # checked once here; the stages below skip their own checks of the same arguments
+    problem = prepare_step(scene, h, theta, gap_tolerance, check=False)
     guess = initial_guess(scene, problem, init)
-    result, vel, spin = solve_problem(scene, problem, guess, review_order, settings)
+    if review_order is not None:
+        review_order = validate.permutation("review_order", review_order, problem.contacts.n)
+    result, vel, spin = solve_problem(scene, problem, guess, review_order, settings, check=False)
     nm = scene.n_mobile
     pos = problem.pos_mid.copy()
     pos[:nm] += theta * h * vel[:nm]

@@ -55,7 +55,7 @@ def _restitution_bias(e_n, e_t, U_initial):
 
 @validate.finite_output
 def solve_discs(scene, contacts, vel, spin, guess=None, review_order=None,
-                settings=SolverSettings(), bias=None, W=None, observe=None):
+                settings=SolverSettings(), bias=None, W=None, observe=None, check=True):
     """Solve the core problem of one step by NLGS in disc form.
 
     ``vel, spin`` hold the free velocities on entry and the end-of-step
@@ -63,9 +63,11 @@ def solve_discs(scene, contacts, vel, spin, guess=None, review_order=None,
     impulse array (n, 2) (zero if None); ``review_order`` a permutation of the
     contacts (identity if None); ``bias`` the restitution term ``e U_i``;
     ``observe(impulse, vel, spin)``: see :func:`ncd.solver.convergence.run_nlgs`.
+    ``check=False``: the caller has checked the arguments (:func:`ncd.step` does).
     """
-    guess, review_order, bias, W = check_disc_problem(scene, contacts, vel, spin, guess, review_order,
-                                                       settings, bias, W)
+    if check:
+        guess, review_order, bias, W = check_disc_problem(scene, contacts, vel, spin, guess, review_order,
+                                                           settings, bias, W)
     if observe is not None and not callable(observe):
         raise InputError(f"observe = {observe!r} must be None or a callable (impulse, vel, spin) -> array")
     n = contacts.n
