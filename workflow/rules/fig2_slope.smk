@@ -18,6 +18,7 @@ CFG2_EXP = {k: CFG2[k] for k in ("scene", "flow", "explore")}
 
 
 rule fig2_slope_simulate:
+    priority: PRIORITY["fig2_slope"]
     input:
         ncd_sources(FIG2),
     output:
@@ -35,6 +36,7 @@ rule fig2_slope_simulate:
 
 
 rule fig2_slope_explore:
+    priority: PRIORITY["fig2_slope"]
     input:
         ncd_sources(FIG2),
         trajectory=f"{F2}/trajectory.nc",
@@ -57,6 +59,7 @@ rule fig2_slope_explore:
 
 
 rule fig2_slope_merge:
+    priority: PRIORITY["fig2_slope"]
     input:
         shard_files(FIG2, "ensemble", CFG2["explore"]["shards"]),
     output:
@@ -74,6 +77,7 @@ rule fig2_slope_merge:
 
 
 rule fig2_slope_analyse:
+    priority: PRIORITY["fig2_slope"]
     input:
         ncd_sources(FIG2),
         trajectory=f"{F2}/trajectory.nc",
@@ -93,6 +97,7 @@ rule fig2_slope_analyse:
 
 
 rule fig2_slope_census:
+    priority: PRIORITY["fig2_slope"]
     input:
         ncd_sources(FIG2),
         trajectory=f"{F2}/trajectory.nc",
@@ -116,6 +121,7 @@ rule fig2_slope_census:
 
 
 rule fig2_slope_notebook:
+    priority: PRIORITY["fig2_slope"]
     input:
         trajectory=f"{F2}/trajectory.nc",
         ensemble=f"{F2}/ensemble.nc",

@@ -25,6 +25,7 @@ F4_SOURCES = [f for f in ncd_sources(FIG4) if f != F4_PLOTS]
 
 
 rule fig4_pile_simulate:
+    priority: PRIORITY["fig4_pile"]
     input:
         F4_SOURCES,
     output:
@@ -42,6 +43,7 @@ rule fig4_pile_simulate:
 
 
 rule fig4_pile_cuts:
+    priority: PRIORITY["fig4_pile"]
     input:
         F4_SOURCES,
         construction=f"{F4}/construction.nc",
@@ -60,6 +62,7 @@ rule fig4_pile_cuts:
 
 
 rule fig4_pile_exact:
+    priority: PRIORITY["fig4_pile"]
     input:
         F4_SOURCES,
         construction=f"{F4}/construction.nc",
@@ -79,6 +82,7 @@ rule fig4_pile_exact:
 
 
 rule fig4_pile_explore:
+    priority: PRIORITY["fig4_pile"]
     input:
         F4_SOURCES,
         construction=f"{F4}/construction.nc",
@@ -103,6 +107,7 @@ rule fig4_pile_explore:
 
 
 rule fig4_pile_merge:
+    priority: PRIORITY["fig4_pile"]
     input:
         lambda w: shard_files(FIG4, w.name, F4_SHARDS[w.name]),
     output:
@@ -122,6 +127,7 @@ rule fig4_pile_merge:
 
 
 rule fig4_pile_notebook:
+    priority: PRIORITY["fig4_pile"]
     input:
         construction=f"{F4}/construction.nc",
         cuts=f"{F4}/cuts.nc",
