@@ -47,7 +47,15 @@ class ExactSet:
         c = validate.array("c", c, (self.n,))
         t0 = time.perf_counter()
         self.highs.changeColsCost(self.n, self._cols, self._Tt @ c * self.scale)
-        self.highs.run()
+        if self._last is None:
+            # no basis yet: interior point and crossover to a vertex (at 10^4 grains ~40 s,
+            # where primal simplex from the slack basis takes over ten minutes), then primal
+            # simplex from that basis for every later LP
+            self.highs.setOptionValue("solver", "ipm")
+            self.highs.run()
+            self.highs.setOptionValue("solver", "simplex")
+        else:
+            self.highs.run()
         status = self.highs.getModelStatus()
         self.n_lp += 1
         self.lp_time += time.perf_counter() - t0
@@ -167,8 +175,10 @@ class ExactSet:
                     return out
             out["n_lp"] = self.n_lp - n0
             return out
-        ends, bounds = [], []
-        for j, sign in enumerate((-1.0, 1.0)):          # min, then max of q / p
+        ends, bounds = [0.0, 0.0], []
+        # max, then min of q / p: the model of A ∩ C is left at the smaller angle's end, near
+        # the next query of the cut in history_exact (the largest vertical component)
+        for j, sign in ((1, 1.0), (0, -1.0)):
             if start is not None:
                 r = self._fractional_end(-sign * cb)     # max of sign q / p
             u = M @ r
@@ -181,7 +191,7 @@ class ExactSet:
                 if v <= tol * self.scale or lam_new <= lam:
                     break
                 lam, r = lam_new, r_new
-            ends.append(ref + sign * np.degrees(np.arctan(lam)))
+            ends[j] = ref + sign * np.degrees(np.arctan(lam))
             bounds.append(max(v, 0.0) / p_min)
             out["points"][j] = r
         out.update(lo=float(ends[0]), hi=float(ends[1]), bound=float(np.degrees(max(bounds))),
