@@ -11,7 +11,8 @@ that each LP restarts (primal simplex) from the previous optimal basis:
 * :meth:`ExactSet.polygon`: the exact image of A ∩ C under a 2-row map (a cut
   resultant), support directions then every hull edge confirmed;
 * :meth:`ExactSet.angle_range`: the exact range of the direction of such an image,
-  a linear-fractional program solved by Dinkelbach's iteration (a few LPs, no polygon).
+  a linear-fractional program: one LP per end on a second, homogenised (Charnes-Cooper)
+  model of A ∩ C, whose basis is handed back to the first for a certifying Dinkelbach LP.
 """
 import time
 
@@ -34,21 +35,31 @@ class ExactSet:
         self.scale, self.n = fp.scale, 2 * fp.n_contacts
         self.T, upper = cone_columns(fp.mu)
         self._Tt = self.T.T.tocsr()
-        h = sector_model(fp.A_eq, fp.b_eq, self.T, upper,
-                         primal_feasibility_tolerance=FEAS_TOL, dual_feasibility_tolerance=FEAS_TOL,
-                         threads=1, random_seed=0, simplex_strategy=4)
+        self._options = dict(primal_feasibility_tolerance=FEAS_TOL, dual_feasibility_tolerance=FEAS_TOL,
+                             threads=1, random_seed=0, simplex_strategy=4)
+        h = sector_model(fp.A_eq, fp.b_eq, self.T, upper, **self._options)
         self.highs, self.n_lp, self.lp_time = h, 0, 0.0
         self._cols = np.arange(self.n, dtype=np.int32)
+        self._upper, self._cc, self._cc_support, self._last = upper, None, np.zeros(0, dtype=np.int64), None
 
     def minimize(self, c):
         """``(min c . r, r)`` over A ∩ C (``c`` in force units, ``r`` forces)."""
         c = validate.array("c", c, (self.n,))
         t0 = time.perf_counter()
         self.highs.changeColsCost(self.n, self._cols, self._Tt @ c * self.scale)
-        self.highs.run()
+        if self._last is None:
+            # no basis yet: interior point and crossover to a vertex (at 10^4 grains ~40 s,
+            # where primal simplex from the slack basis takes over ten minutes), then primal
+            # simplex from that basis for every later LP
+            self.highs.setOptionValue("solver", "ipm")
+            self.highs.run()
+            self.highs.setOptionValue("solver", "simplex")
+        else:
+            self.highs.run()
         status = self.highs.getModelStatus()
         self.n_lp += 1
         self.lp_time += time.perf_counter() - t0
+        self._last = "lp"
         if status == highspy.HighsModelStatus.kInfeasible:
             raise PolytopeError("A ∩ C is empty: no contact forces balance the weights")
         if status != highspy.HighsModelStatus.kOptimal:
@@ -118,17 +129,20 @@ class ExactSet:
 
         Around a reference direction ``phi0`` (``ref``; default, or NaN: an LP point), with
         ``p = a . u``, ``q = b . u`` (``u = (outer g_x, -g_y)``, ``a`` along ``phi0``, ``b``
-        normal to it), ``tan(phi - phi0) = q / p``.  One LP certifies ``p > 0`` on all of
-        A ∩ C (the image lies in an open half-plane, so its angles span less than 180°);
-        then ``max q / p`` (and ``min``) by Dinkelbach's iteration: with ``lam = q / p``
-        at the current point, ``max (q - lam p)`` is 0 at the optimum, and otherwise its
-        maximiser has a larger ratio.  The final LP value ``v`` bounds the error of the
-        ratio by ``v / p_min`` (``bound``, radians, reported).  Returns a dict: ``lo``, ``hi``
-        (degrees), ``bound`` (the larger of the two certificates, degrees), ``p_min``
-        (N), ``n_lp``, ``points`` (forces at the two extremes); ``lo = hi = nan`` and
-        ``p_min <= 0`` when the image contains the origin.  If ``ref`` does not separate the
-        image from the origin, the exact polygon (:meth:`polygon`) gives a direction that
-        does, and the range is computed again around it (``retry``).
+        normal to it), ``tan(phi - phi0) = q / p``.  The Charnes-Cooper model
+        (:meth:`_fractional`, ``y = r / p``, ``t = 1 / p``) gives ``min p`` (``p_min``: ``p > 0``
+        on all of A ∩ C, so the image lies in an open half-plane and its angles span less
+        than 180°) and each end of ``q / p`` in one LP apiece.  Each end is then certified by
+        Dinkelbach's iteration on A ∩ C started there: with ``lam = q / p`` at the current
+        point, ``max (q - lam p)`` is 0 at the optimum, and otherwise its maximiser has a
+        larger ratio (the first such LP starts from the end's basis and usually pivots
+        nowhere).  The final LP value ``v`` bounds the error of the ratio by ``v / p_min``
+        (``bound``, radians, reported).  Returns a dict: ``lo``, ``hi`` (degrees), ``bound``
+        (the larger of the two certificates, degrees), ``p_min`` (N), ``n_lp``, ``points``
+        (forces at the two extremes); ``lo = hi = nan`` and ``p_min <= 0`` when the image
+        contains the origin.  If ``ref`` does not separate the image from the origin, the
+        exact polygon (:meth:`polygon`) gives a direction that does, and the range is
+        computed again around it (``retry``).
         """
         L = validate.matrix("L", L, (2, self.n))
         M = sp.diags([float(outer), -1.0]) @ L          # r -> u = (outer g_x, -g_y)
@@ -139,7 +153,12 @@ class ExactSet:
             ref = np.degrees(np.arctan2(u[1], u[0]))
         t = np.radians(ref)
         a, b = np.array([np.cos(t), np.sin(t)]), np.array([-np.sin(t), np.cos(t)])
-        p_min, r = self.minimize(Mt @ a)
+        ca, cb = Mt @ a, Mt @ b
+        start = self._fractional(ca, cb)
+        if start is None:                                # p > 0 not certified: min p on A ∩ C itself
+            p_min, r = self.minimize(ca)
+        else:
+            p_min, r = start[0], start[1]
         out = {"p_min": p_min, "lo": np.nan, "hi": np.nan, "bound": np.nan, "points": np.zeros((2, L.shape[1]))}
         if not p_min > 1e-9 * self.scale:
             # the reference direction does not separate the image from the origin: the
@@ -156,8 +175,12 @@ class ExactSet:
                     return out
             out["n_lp"] = self.n_lp - n0
             return out
-        ends, bounds = [], []
-        for j, sign in enumerate((-1.0, 1.0)):          # min, then max of q / p
+        ends, bounds = [0.0, 0.0], []
+        # max, then min of q / p: the model of A ∩ C is left at the smaller angle's end, near
+        # the next query of the cut in history_exact (the largest vertical component)
+        for j, sign in ((1, 1.0), (0, -1.0)):
+            if start is not None:
+                r = self._fractional_end(-sign * cb)     # max of sign q / p
             u = M @ r
             lam = sign * (b @ u) / (a @ u)
             for _ in range(max_lp):
@@ -168,12 +191,100 @@ class ExactSet:
                 if v <= tol * self.scale or lam_new <= lam:
                     break
                 lam, r = lam_new, r_new
-            ends.append(ref + sign * np.degrees(np.arctan(lam)))
+            ends[j] = ref + sign * np.degrees(np.arctan(lam))
             bounds.append(max(v, 0.0) / p_min)
             out["points"][j] = r
         out.update(lo=float(ends[0]), hi=float(ends[1]), bound=float(np.degrees(max(bounds))),
                    n_lp=self.n_lp - n0)
         return out
+
+    def _fractional(self, ca, cb):
+        """``(p_min, r)``: ``min p = ca . r`` over A ∩ C by the Charnes-Cooper model, or
+        None if that model cannot certify ``p > 0`` (then :meth:`angle_range` falls back
+        to the LP over A ∩ C and the exact polygon).
+
+        The homogenised model ``H y + F t = 0``, ``y`` in the Coulomb sectors, ``t >= 0``,
+        ``ca . y = 1`` is built once (:meth:`_homogenised`); a cut changes only its
+        normalisation row (``ca`` is sparse: the contacts the cut crosses).  ``max t``
+        is ``1 / min p`` when ``p > 0`` on A ∩ C (``r = y / t``), and unbounded or
+        infeasible otherwise.  A basis of A ∩ C with ``t`` added as basic is a basis of
+        the homogenised model, feasible where ``p > 0`` at its vertex, so the model
+        restarts from the last LP of either model."""
+        h = self._homogenised()
+        w = self._Tt @ ca                               # ca . r = scale (w . z), r = scale T z
+        idx = np.nonzero(w)[0]
+        row = h.getNumRow() - 1
+        for j in np.setdiff1d(self._cc_support, idx):
+            h.changeCoeff(row, int(j), 0.0)
+        for j in idx:
+            h.changeCoeff(row, int(j), float(w[j]))
+        self._cc_support = idx
+        if len(idx) == 0:
+            return None
+        if self._last is None:                           # no basis yet: A ∩ C's own LP starts faster
+            self.minimize(ca)
+        if self._last == "lp":
+            self._carry_basis(self.highs, h, add_t=True)
+        cost = np.zeros(self.n + 1)
+        cost[-1] = -1.0
+        status, x = self._cc_run(cost)
+        if status != highspy.HighsModelStatus.kOptimal or not x[-1] > 0.0:
+            return None
+        return self.scale / x[-1], self.T @ np.maximum(x[:-1], 0.0) / x[-1] * self.scale
+
+    def _fractional_end(self, c):
+        """Forces ``r`` minimising ``c . r / p`` (the normalisation row set by
+        :meth:`_fractional`) by one LP of the homogenised model, with its basis handed to
+        the model of A ∩ C (``t`` dropped) for the certifying LP."""
+        status, x = self._cc_run(np.append(self._Tt @ c, 0.0))
+        if status != highspy.HighsModelStatus.kOptimal or not x[-1] > 0.0:
+            raise PolytopeError(f"LP not solved: {self._cc.modelStatusToString(status)}")
+        self._carry_basis(self._cc, self.highs, add_t=False)
+        return self.T @ np.maximum(x[:-1], 0.0) / x[-1] * self.scale
+
+    def _homogenised(self):
+        """The Charnes-Cooper model of A ∩ C: columns ``(z, t)`` (``z`` the sector columns
+        of :func:`cone_columns`), rows ``A_eq T z - b_eq t = 0`` and a normalisation row
+        (empty until :meth:`_fractional` fills it), built on first use."""
+        if self._cc is None:
+            fp = self.fp
+            m = fp.A_eq.shape[0]
+            A = sp.vstack([sp.hstack([fp.A_eq @ self.T, -fp.b_eq[:, None]]), sp.csr_matrix((1, self.n + 1))])
+            rhs = np.zeros(m + 1)
+            rhs[-1] = 1.0
+            self._cc = sector_model(A, rhs, sp.identity(self.n + 1, format="csr"),
+                                    np.append(self._upper, highspy.kHighsInf), **self._options)
+        return self._cc
+
+    def _cc_run(self, cost):
+        t0 = time.perf_counter()
+        h = self._cc
+        h.changeColsCost(self.n + 1, np.arange(self.n + 1, dtype=np.int32), cost)
+        h.run()
+        self.n_lp += 1
+        self.lp_time += time.perf_counter() - t0
+        self._last = "cc"
+        return h.getModelStatus(), np.asarray(h.getSolution().col_value)
+
+    @staticmethod
+    def _carry_basis(src, dst, add_t):
+        """Hand the optimal basis of one model to the other: ``t`` basic and the
+        normalisation row nonbasic added (``add_t``) or dropped; nothing if ``src`` has
+        no valid basis or ``t`` is not basic in it."""
+        basis = src.getBasis()
+        if not basis.valid:
+            return
+        cols, rows = list(basis.col_status), list(basis.row_status)
+        if add_t:
+            cols.append(highspy.HighsBasisStatus.kBasic)
+            rows.append(highspy.HighsBasisStatus.kLower)
+        elif cols[-1] == highspy.HighsBasisStatus.kBasic and rows[-1] != highspy.HighsBasisStatus.kBasic:
+            cols, rows = cols[:-1], rows[:-1]
+        else:
+            return
+        new = highspy.HighsBasis()
+        new.col_status, new.row_status = cols, rows
+        dst.setBasis(new)
 
 
 def sector_model(A_eq, b_eq, T, upper, **options):

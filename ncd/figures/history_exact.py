@@ -3,7 +3,7 @@
 Over ``A ∩ C`` of one pile's final configuration (:class:`ncd.exact.exact_set.ExactSet`),
 the exact range of the angle of the resultant across each cut of
 :func:`ncd.figures.history_analysis.pile_measures`: a linear-fractional program, solved
-by Dinkelbach's iteration with a certified error bound.  The history forces' angle must
+by the Charnes-Cooper LP with a certified error bound (a Dinkelbach LP).  The history forces' angle must
 lie in that range (``history_outside`` counts the exceptions).
 """
 import time
@@ -47,7 +47,7 @@ def exact_ranges(cfg, ds, log=None):
         amin.append(rng["lo"])
         amax.append(rng["hi"])
         bound.append(rng["bound"])
-        fy_max.append(es.interval(C[2 * k + 1].toarray().ravel())[1])
+        fy_max.append(-es.minimize(-C[2 * k + 1].toarray().ravel())[0])     # max only: one LP
         n_lp.append(es.n_lp - n0)
         if log is not None:     # a 10^4-grain pile takes minutes per cut: show the progress
             log.info("cut %d of %d: angle range [%.3f, %.3f] deg, %d LPs, %.0f s so far", k + 1, len(specs),

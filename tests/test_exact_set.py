@@ -1,0 +1,89 @@
+"""Angle ranges of ExactSet by the Charnes-Cooper model against plain Dinkelbach iterations
+and against the exact polygon, on a pile of a few tens of discs."""
+import numpy as np
+import pytest
+
+import ncd
+from ncd.exact.exact_set import ExactSet
+from ncd.figures.pile_exact import resultant_angle
+from ncd.scenes import cuts as cm
+from tests.test_pile_exact import balanced
+
+
+def lattice_pile(n_base=7, mu=0.3):
+    """A triangular pile of n_base (n_base + 1) / 2 touching discs (radius 1) on n_base + 1
+    fixed discs: hyperstatic with friction, so A ∩ C is a polytope of many dimensions."""
+    h = np.sqrt(3.0)
+    ground = np.column_stack([2.0 * np.arange(n_base + 1) - n_base, np.zeros(n_base + 1)])
+    pos = np.array([[2.0 * i - (n_base - 1 - j), (j + 1) * h] for j in range(n_base) for i in range(n_base - j)])
+    return ncd.make_scene(pos, np.ones(len(pos)), 1.0, obstacle_pos=ground, obstacle_radius=np.ones(len(ground)),
+                          gravity=(0.0, -10.0), mu=mu)
+
+
+def dinkelbach(es, L, outer, ref, tol=1e-12):
+    """The angle range by Dinkelbach's iteration alone on A ∩ C from the ``min p`` point
+    (the route without the homogenised model): ``(lo, hi, p_min)``, degrees."""
+    M = np.diag([float(outer), -1.0]) @ L
+    t = np.radians(ref)
+    a, b = np.array([np.cos(t), np.sin(t)]), np.array([-np.sin(t), np.cos(t)])
+    p_min, r0 = es.minimize(M.T @ a)
+    ends = []
+    for sign in (-1.0, 1.0):
+        r = r0
+        lam = sign * (b @ M @ r) / (a @ M @ r)
+        for _ in range(100):
+            v, r_new = es.minimize(-(M.T @ (sign * b - lam * a)))
+            lam_new = sign * (b @ M @ r_new) / (a @ M @ r_new)
+            if -v <= tol * es.scale or lam_new <= lam:
+                break
+            lam, r = lam_new, r_new
+        ends.append(ref + sign * np.degrees(np.arctan(lam)))
+    return ends[0], ends[1], p_min
+
+
+@pytest.fixture(scope="module")
+def pile():
+    scene = lattice_pile()
+    c, H, F = balanced(scene)
+    specs = [(s * x, s, -np.inf, np.inf) for s in (-1, 1) for x in (0.5, 1.5, 2.5, 3.5, 4.5)]
+    C, counts = cm.cut_matrix(c, scene.pos, scene.n_mobile, specs)
+    assert counts.min() >= 2
+    outer = np.repeat([-1, 1], 5)
+    return H, F, c.mu, C.toarray(), outer
+
+
+def test_angle_range_equals_plain_dinkelbach_and_certifies_with_one_lp_per_end(pile):
+    """The Charnes-Cooper ends, certified by one Dinkelbach LP each, against Dinkelbach's
+    iteration alone (a separate model): the same angles to 1e-9 degree, the same p_min;
+    five LPs per cut (min p, two ends, two certificates, whose LP starts at its optimum)."""
+    H, F, mu, C, outer = pile
+    es, plain = ExactSet(H, F, mu), ExactSet(H, F, mu)
+    widths = []
+    for k in range(len(outer)):
+        L = C[2 * k: 2 * k + 2]
+        g = L @ es.minimize(np.zeros(es.n))[1]
+        ref = np.degrees(np.arctan2(-g[1], outer[k] * g[0])) + 3.0    # a separating reference, off centre
+        r = es.angle_range(L, outer[k], ref=ref)
+        assert es.highs.getInfo().simplex_iteration_count == 0
+        lo, hi, p_min = dinkelbach(plain, L, outer[k], ref)
+        assert abs(r["lo"] - lo) <= 1e-9 and abs(r["hi"] - hi) <= 1e-9
+        assert abs(r["p_min"] - p_min) <= 1e-9 * es.scale and r["bound"] <= 1e-9
+        assert r["n_lp"] == 5
+        eq, co = es.fp.violations(r["points"])
+        assert eq.max() <= 1e-9 and co.max() <= 1e-9
+        widths.append(hi - lo)
+    assert min(widths) > 1.0                                          # ranges worth comparing
+
+
+def test_angle_range_equals_the_angles_of_the_exact_polygon(pile):
+    """Against an independent computation: the angle range of the vertices of the exact
+    image polygon (support LPs until every hull edge is confirmed)."""
+    H, F, mu, C, outer = pile
+    es = ExactSet(H, F, mu)
+    for k in range(len(outer)):
+        L = C[2 * k: 2 * k + 2]
+        poly = es.polygon(L, n_dirs=90)
+        assert poly["exact"]
+        lo, hi = resultant_angle(poly["vertices"], outer[k])
+        r = es.angle_range(L, outer[k])
+        assert abs(r["lo"] - lo) <= 1e-8 and abs(r["hi"] - hi) <= 1e-8
