@@ -138,17 +138,19 @@ def test_changing_a_scene_parameter_reruns_that_scene_only(dag_repo, tmp_path, f
 
 
 def test_an_ensemble_does_not_depend_on_shards_threads_or_jobs(dag_repo, tmp_path):
-    """fig3's merged ensemble rebuilt elsewhere with 3 shards per mode at -j1 (one thread
-    per shard) holds the same numbers as the DAG's (2 shards, -j2: two threads per
+    """fig3's merged ensemble rebuilt elsewhere with 3 shards per mode and two threads per
+    shard (--set-threads) holds the same numbers as the DAG's (2 shards, one thread per
     shard); only the measured wall times may differ."""
     overlay = write_overlay(tmp_path, {"fig3_equilibrium": {"modes": {"zero": {"shards": 3},
                                                                       "random": {"shards": 3}}}})
     work = tmp_path / "work"
-    run_snakemake(dag_repo, "-j1", "results/fig3_equilibrium/ensemble.nc", extra_configs=[overlay], workdir=work)
+    run_snakemake(dag_repo, "-j2", "results/fig3_equilibrium/ensemble.nc", "--set-threads",
+                  "fig3_equilibrium_explore=2", extra_configs=[overlay], workdir=work)
     ref = xr.load_dataset(dag_repo / "results" / "fig3_equilibrium" / "ensemble.nc")
     new = xr.load_dataset(work / "results" / "fig3_equilibrium" / "ensemble.nc")
     assert not list((work / "results" / "fig3_equilibrium" / "shards").glob("*.nc"))   # temp(): removed once merged
-    assert len(list((work / "results" / "logs" / "fig3_equilibrium").glob("explore_*_*-of-3.log"))) == 6
+    logs = list((work / "results" / "logs" / "fig3_equilibrium").glob("explore_*_*-of-3.log"))
+    assert len(logs) == 6 and all("threads 2" in f.read_text() for f in logs)
     assert ref.sizes["run"] > 100
     timing = [v for v in ref.data_vars if "wall_time" in v]
     xr.testing.assert_identical(ref.drop_vars(timing).drop_attrs(), new.drop_vars(timing).drop_attrs())

@@ -33,8 +33,11 @@ FIGURES = [f for f in ("fig1_wedged", "fig2_slope", "fig3_equilibrium", "fig4_pi
 check_config(config, FIGURES, ROOT / "workflow" / "schemas")
 
 # Threads of an ensemble rule: its NLGS runs are spread over them (ncd.dynamics.explore.run_parallel,
-# results identical whatever the count); Snakemake lowers it to the cores it was given.
-ENSEMBLE_THREADS = 2
+# results identical whatever the count).  One: Snakemake starts a job only when its threads are free
+# at once, so a 2-thread job waits behind the stream of 1-thread jobs until nothing else is left (on
+# -j2 Figure 2's ensembles then started last and set the run time).  Parallelism comes from the
+# shards instead; raise it per rule with --set-threads on a larger machine.
+ENSEMBLE_THREADS = 1
 
 # Snakemake starts the ready job of highest priority first.  The longest chains of the default
 # run (the critical path of results/bench/dag.nc: Figure 2's flow, its ensembles and census,
