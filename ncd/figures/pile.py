@@ -157,9 +157,9 @@ def ensemble_shard(cfg, construction, cuts, members, tolerances, root_seed, log=
                   "observable_change", "finish_rounds", "finish_correction"):
             res[k][rows, j] = out[k]
         if log is not None:
-            log.info("tol %g: %d runs (%d run, the others the same as at the previous tolerance), %d converged, "
-                     "sweeps %d..%d", tol, len(members), len(rows), res["converged"][:, j].sum(),
-                     res["sweeps"][:, j].min(), res["sweeps"][:, j].max())
+            copied = f" ({len(members) - len(rows)} copied from the previous tolerance)" if j > 0 else ""
+            log.info("tol %g: %d runs%s, %d converged, sweeps %d..%d", tol, len(members), copied,
+                     res["converged"][:, j].sum(), res["sweeps"][:, j].min(), res["sweeps"][:, j].max())
     data = {}
     for k, v in res.items():
         tail = () if v.ndim == 2 else ("cut",) if k.startswith("cut") else ("bin",)
