@@ -2,12 +2,12 @@
 and against the exact polygon, on a pile of a few tens of discs."""
 import numpy as np
 import pytest
+from test_pile_exact import balanced
 
 import ncd
 from ncd.exact.exact_set import ExactSet
 from ncd.figures.pile_exact import resultant_angle
 from ncd.scenes import cuts as cm
-from tests.test_pile_exact import balanced
 
 
 def lattice_pile(n_base=7, mu=0.3):
