@@ -85,7 +85,9 @@ def test_frictionless_packing_is_isostatic_and_determinate(frictionless_cell):
     dim (A ∩ C) = 0, every contact fixed, eta_U = 0 on the uniform sample (one point) and on
     the random walk (every relaxation returns the history state to round-off)."""
     p, cell, forces, contacts, _ = frictionless_cell
-    sl = fg.slice_of(cell, contacts, fg.exact_rest(cell, contacts, forces, 0.0), p)
+    exact_forces, exact = fg.exact_rest(cell, contacts, forces, 0.0)
+    assert exact and np.abs(exact_forces - forces).max() <= 1e-8 * cell.force
+    sl = fg.slice_of(cell, contacts, exact_forces, p, exact)
     assert len(sl.mu) >= 5 and (sl.mu == 0).all()
     m = ge.exact_measures(sl.H, sl.F, sl.mu, feas_tol=1e-9)
     assert (m["dim_AC_rank"], m["dim_AC_lp"]) == (0, 0) and m["n_fixed"] == m["n_contacts"]
@@ -94,6 +96,24 @@ def test_frictionless_packing_is_isostatic_and_determinate(frictionless_cell):
     assert gu.eta_u(walk["samples"]) <= 1e-9
     uni = gu.uniform_sample(sl, m, dict(per_chain=20, rounds=0), lambda k: np.random.default_rng(k), 1e-9)
     assert uni["dimension"] == 0 and uni["eta"] == 0.0
+
+
+def test_slice_balanced_by_its_reference_forces(frictionless_cell):
+    """Rest forces balanced to ~1e-10 only (a refinement not taken, as in thin cones): with
+    ``balance`` the slice's loads are those its reference forces balance, to round-off, and its
+    exact set is the same single point; the boundary forces' loads miss by the perturbation."""
+    p, cell, forces, contacts, _ = frictionless_cell
+    rough = forces * (1.0 + 1e-9 * np.random.default_rng(3).uniform(-1.0, 1.0, forces.shape))
+    mid, half = 0.5 * cell.plate_y, 0.5 * p["slice_radii"] * p["radius_min"]
+    plain = plates.slice_problem(cell, contacts, rough, mid - half, mid + half, p["h"])
+    sl = fg.slice_of(cell, contacts, rough, p, exact=False)
+    scale = np.abs(sl.F).max()
+    assert np.abs(sl.H @ sl.reference.ravel() + sl.F).max() <= 1e-14 * scale
+    assert np.abs(plain.H @ plain.reference.ravel() + plain.F).max() >= 1e-12 * scale
+    np.testing.assert_allclose(sl.F, plain.F, rtol=0, atol=1e-8 * scale)
+    m = ge.exact_measures(sl.H, sl.F, sl.mu, feas_tol=1e-9)
+    assert m["dim_AC_rank"] == 0 and m["n_fixed"] == m["n_contacts"]
+    np.testing.assert_allclose(0.5 * (m["force_min"] + m["force_max"]), sl.reference, rtol=0, atol=1e-7 * scale)
 
 
 def test_eta_u_of_a_uniform_segment():

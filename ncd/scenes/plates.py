@@ -172,9 +172,14 @@ class Slice:
     problem: StepProblem
 
 
-def slice_problem(cell, contacts, forces, y_lo, y_hi, h):
+def slice_problem(cell, contacts, forces, y_lo, y_hi, h, balance=False):
     """The slice ``y_lo <= y < y_hi`` (disc centres) with every other contact fixed at ``forces``
-    (an equilibrium of the whole cell, one row per contact of ``contacts``)."""
+    (an equilibrium of the whole cell, one row per contact of ``contacts``).
+
+    ``balance``: the loads are ``-H r`` of the slice's own ``forces`` instead of the boundary
+    forces' (they differ by the cell's equilibrium residual on the slice's rows).  For forces
+    balanced only to ~1e-10: the right-hand side of dependent equations is then consistent,
+    without which the slice's LP is infeasible at any tolerance."""
     s, n = cell.scene, cell.n
     inside = np.zeros(s.n_disc, bool)
     inside[:n] = (s.pos[:n, 1] >= y_lo) & (s.pos[:n, 1] < y_hi)
@@ -189,6 +194,8 @@ def slice_problem(cell, contacts, forces, y_lo, y_hi, h):
     bcols = (2 * touch[:, None] + np.arange(2)).ravel()
     F = (H[:, bcols] @ forces[touch].ravel())[rows]
     cols = (2 * inner[:, None] + np.arange(2)).ravel()
+    if balance:
+        F = -(H[rows][:, cols] @ forces[inner].ravel())
     Hs = H[rows][:, cols].tocsr()
     Hs.eliminate_zeros()
     index = np.full(s.n_disc, -1, np.int64)
