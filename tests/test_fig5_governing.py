@@ -390,3 +390,21 @@ def test_flow_settings_one_factor_at_a_time():
         gf.settings_table(dict(f, h=[5e-4]))
     with pytest.raises(ncd.InputError, match="duration"):
         gf.scan_times(dict(f, duration=0.001))
+
+
+def test_mean_settling_compares_means_over_packings():
+    """The walk's convergence in the means over packings: packing A moves only in its second
+    half ([1, 1, 1, 3, 3]: eta_U 0 then 0.6086), B oscillates ([2, 4, 2, 4, 2]: 0.4330 then
+    0.3912), a determinate C counts 0; (0 + 0.4330 + 0) / (0.6086 + 0.3912 + 0) - 1 = -0.567."""
+    n = np.array([[1, 1, 1, 3, 3], [2, 4, 2, 4, 2], [5, 5, 5, 5, 5]], float)[:, :, None]
+    ds = xr.Dataset({"walk_n": (("packing", "sample", "contact"), n),
+                     "walk_t": (("packing", "sample", "contact"), np.zeros_like(n)),
+                     "walk_point": (("packing", "sample"), np.ones((3, 5), np.int8)),
+                     "n_contacts": ("packing", [1, 1, 1]), "dim_AC_rank": ("packing", [1.0, 1.0, 0.0]),
+                     "kind": ("packing", [0, 0, 0]), "mu_index": ("packing", [0, 0, 0])})
+    assert gc.walk_eta_at(ds, 0, 2) == 0.0 and gc.walk_eta_at(ds, 2, 4) == 0.0
+    assert gc.walk_eta_at(ds, 0, 4) == pytest.approx(np.sqrt(1.2) / 1.8, rel=1e-12)
+    assert gc.walk_eta_at(ds, 1, 2) == pytest.approx(np.sqrt(4 / 3) / (8 / 3), rel=1e-12)
+    full = (np.sqrt(1.2) / 1.8 + np.sqrt(1.2) / 2.8) / 3
+    assert gc.mean_settling(ds) == pytest.approx(1 - np.sqrt(4 / 3) / (8 / 3) / 3 / full, rel=1e-12)
+    assert gc.mean_settling(ds, kind=1) == 0.0

@@ -94,6 +94,33 @@ def walk_settling(ds):
     return (float(np.median(out)), float(np.max(out)), len(out)) if out else (np.nan, np.nan, 0)
 
 
+def walk_eta_at(ds, j, count):
+    """eta_U of analysis ``j`` over its first ``count`` walk rounds (accepted samples only; 0 on a
+    determinate slice, as in :func:`ncd.figures.governing.analyse`)."""
+    if int(ds.dim_AC_rank[j]) == 0:
+        return 0.0
+    ok = ds.walk_point.values[j, : count + 1] == 1
+    k = int(ds.n_contacts[j])
+    f = np.stack([ds.walk_n.values[j, : count + 1][ok][:, :k], ds.walk_t.values[j, : count + 1][ok][:, :k]], axis=-1)
+    return eta_u(f) if len(f) > 1 else np.nan
+
+
+def mean_settling(ds, kind=0):
+    """Largest ``|mean eta_U over half the walk rounds / mean over all - 1|`` over the mu of
+    series ``kind`` with a positive mean: the walk's convergence in the quantity the verdicts
+    use (means over packings), not packing by packing."""
+    rounds = ds.sizes["sample"] - 1
+    sel = ds.kind.values == kind
+    worst = 0.0
+    for i in np.unique(ds.mu_index.values[sel]):
+        rows = np.nonzero(sel & (ds.mu_index.values == i))[0]
+        half = np.nanmean([walk_eta_at(ds, j, rounds // 2) for j in rows])
+        full = np.nanmean([walk_eta_at(ds, j, rounds) for j in rows])
+        if full > 0:
+            worst = max(worst, abs(half / full - 1.0))
+    return float(worst)
+
+
 def study_summary(ds, cfg):
     """One paragraph of the study's numbers: packings, slices, dimensions, boundedness, walk
     and uniform-sample acceptance (the page's first measured paragraph)."""
@@ -212,5 +239,5 @@ def claim_unger_centrality(results):
                    "unger-centrality", (DATA,))
 
 
-__all__ = ["study_summary", "walk_settling", "peak", "small_mu_slope", "vanishing", "control_trend", "centrality_summary", "claim_unger_peak",
+__all__ = ["study_summary", "walk_settling", "walk_eta_at", "mean_settling", "peak", "small_mu_slope", "vanishing", "control_trend", "centrality_summary", "claim_unger_peak",
            "claim_unger_vanishes", "claim_unger_control", "claim_unger_centrality", "PEAK_MU", "Z_ISOSTATIC"]
