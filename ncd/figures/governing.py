@@ -28,7 +28,15 @@ from ncd.dynamics.explore import member_rng, shard_members
 from ncd.exact.exact_set import ExactSet
 from ncd.exact.polytope import ForcePolytope
 from ncd.figures.governing_exact import exact_measures
-from ncd.figures.governing_unger import centrality, eta_u, random_walk, uniform_sample
+from ncd.figures.governing_unger import (
+    MIXED_GAP,
+    MIXED_RHAT,
+    centrality,
+    chains_agree,
+    eta_u,
+    random_walk,
+    uniform_sample,
+)
 from ncd.io.netcdf import merge_shards, provenance
 from ncd.scenes import plates
 from ncd.solver.settings import SolverSettings
@@ -321,8 +329,8 @@ SCALARS = {"n_contacts": "contacts kappa in the slice", "rank_H": "rank of the s
            "closer to the centre than the history state", "history_distance": "|history - centre| / <|F|>",
            "walk_distance": "mean |walk sample - centre| / <|F|>", "uniform_distance": "mean |uniform sample - "
            "centre| / <|F|>", "walk_ok": "random-walk samples that are points of A ∩ C",
-           "mixed": "1: the two uniform chains agree (eta_U gap <= 0.3, R-hat <= 1.2)"}
-MIXED_GAP, MIXED_RHAT = 0.3, 1.2
+           "mixed": "1: the two uniform chains agree (eta_U gap <= 0.3, R-hat <= 1.2)",
+           "uniform_per_chain": "points per uniform chain (longer where the first chains did not agree)"}
 
 
 def analysis_shard(builds, cfg, shard, n_shards, progress=None):
@@ -362,7 +370,8 @@ def _dataset(rows, table, sel, builds, cfg):
         if u is not None:
             umean[j, :, :k], ustd[j, :, :k] = u["chain_mean"], u["chain_std"]
             r.update(eta_uniform=u["eta"], eta_uniform_gap=u["gap"], rhat=u["rhat"], dim_uniform=u["dimension"],
-                     mixed=float(u["gap"] <= MIXED_GAP and u["rhat"] <= MIXED_RHAT), **r["centrality"])
+                     mixed=float(chains_agree(u["gap"], u["rhat"])), uniform_per_chain=u["per_chain"],
+                     **r["centrality"])
         r["walk_ok"] = int(r["ok"].sum())
         r.setdefault("mixed", 0.0)
     scal = {q: np.array([r.get(q, np.nan) for r in rows], float) for q in SCALARS}

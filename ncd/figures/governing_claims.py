@@ -15,7 +15,7 @@ import xarray as xr
 from scipy import stats
 
 from ncd.core.verdict import DIFFERS, NOT_COMPUTED, NOT_TESTED, REPRODUCED, Verdict
-from ncd.figures.governing import MIXED_GAP, MIXED_RHAT, eta_table, mixed_only
+from ncd.figures.governing import eta_table, mixed_only
 from ncd.figures.governing_unger import eta_u
 
 DATA = "fig5_governing/packings.nc"
@@ -121,6 +121,14 @@ def mean_settling(ds, kind=0):
     return float(worst)
 
 
+def _span(values, default):
+    """``"a"`` or ``"a–b"`` of the finite values (``default`` when there are none)."""
+    v = np.asarray(values, float)
+    v = v[np.isfinite(v)]
+    lo, hi = (int(v.min()), int(v.max())) if len(v) else (default, default)
+    return f"{lo}" if lo == hi else f"{lo}–{hi}"
+
+
 def study_summary(ds, cfg):
     """One paragraph of the study's numbers: packings, slices, dimensions, boundedness, walk
     and uniform-sample acceptance (the page's first measured paragraph)."""
@@ -139,8 +147,9 @@ def study_summary(ds, cfg):
         f"of {ds.sizes['packing']} analyses); the slice's A ∩ C is bounded in {int(ds.bounded.sum())} and the whole "
         f"cell's in {int(ds.bounded_cell.sum())} of them. Random walk: {w['samples']} rounds per analysis, "
         f"{int(ds.walk_ok.sum() - ds.sizes['packing'])} of {w['samples'] * ds.sizes['packing']} relaxed states "
-        f"points of A ∩ C (a failed round leaves the walk in place). Uniform sample: 2 chains × {u['per_chain']} "
-        f"points from dispersed starts; they agree (η_U within {MIXED_GAP:.0%}, R-hat ≤ {MIXED_RHAT}) on "
+        f"points of A ∩ C (a failed round leaves the walk in place). Uniform sample: 2 chains of {_span(ds.uniform_per_chain, u['per_chain'])} "
+        f"points from dispersed starts (4 times longer, up to {u.get('max_per_chain', u['per_chain'])}, where "
+        "shorter chains did not agree); they agree (η_U within {MIXED_GAP:.0%}, R-hat ≤ {MIXED_RHAT}) on "
         f"{int(ds.mixed.sum())} of {int(ds.bounded.sum())} analyses; the others (at μ = {others}) are left out of "
         "every uniform-sample number below and in the figure.")
 

@@ -80,12 +80,32 @@ def _is_point(P, r, tol):
     return bool(eq[0] <= tol and co[0] <= tol)
 
 
+MIXED_GAP, MIXED_RHAT = 0.3, 1.2   # two chains agree: eta_U within 30 %, Gelman-Rubin R-hat at most 1.2
+
+
+def chains_agree(gap, rhat):
+    """The mixing check of two chains from dispersed starts (:data:`MIXED_GAP`, :data:`MIXED_RHAT`)."""
+    return bool(gap <= MIXED_GAP and rhat <= MIXED_RHAT)
+
+
 def uniform_sample(sl, exact, u, rng_of, feas_tol=1e-10):
     """Two hit-and-run chains of ``u["per_chain"]`` points from dispersed starts, uniform on
     ``A ∩ C`` of slice ``sl`` (``exact``: its :func:`exact_measures`, for the implicit
-    equalities).  Returns the pooled samples (2 per_chain, kappa, 2), per-chain means and
-    standard deviations (2, kappa, 2), ``eta`` (pooled), ``gap`` (|eta_1 - eta_2| / eta),
-    ``rhat`` and the dimension."""
+    equalities); chains that do not agree (:func:`chains_agree`) are drawn again, 4 times
+    longer, up to ``u["max_per_chain"]`` points: the cost goes where the set is hard to mix
+    (thin, elongated), the same generators make the result independent of the shards.
+    Returns the pooled samples (2 per_chain, kappa, 2), per-chain means and standard
+    deviations (2, kappa, 2), ``eta`` (pooled), ``gap`` (|eta_1 - eta_2| / eta), ``rhat``,
+    the dimension and ``per_chain`` (the length used)."""
+    per_chain, cap = u["per_chain"], max(u.get("max_per_chain", u["per_chain"]), u["per_chain"])
+    while True:
+        out = _two_chains(sl, exact, u, per_chain, rng_of, feas_tol)
+        if chains_agree(out["gap"], out["rhat"]) or 4 * per_chain > cap:
+            return out
+        per_chain *= 4
+
+
+def _two_chains(sl, exact, u, per_chain, rng_of, feas_tol):
     # sampled in r' = (r_n, r_t / mu): the Coulomb sectors become right angles, the thin
     # tangential directions of small mu as wide as the normal ones (a linear map: uniform
     # in r' is uniform in r), and the implicit rows are the same rows
@@ -95,15 +115,15 @@ def uniform_sample(sl, exact, u, rng_of, feas_tol=1e-10):
     H = sl.H @ sp.diags(stretch.ravel())
     P = ForcePolytope(H, sl.F, np.where(sl.mu > 0, 1.0, 0.0), feas_tol)
     d = max(int(exact["dim_AC_rank"]), 1)
-    x, info = P.uniform_samples(rng_of, 2, u["per_chain"], thin=u.get("thin", 4) * d, rounds=u["rounds"],
+    x, info = P.uniform_samples(rng_of, 2, per_chain, thin=u.get("thin", 4) * d, rounds=u["rounds"],
                                 implicit=exact["implicit"], dispersed=True)
-    x = x.reshape(2, u["per_chain"], k, 2) * stretch
+    x = x.reshape(2, per_chain, k, 2) * stretch
     etas = [eta_u(c) for c in x]
     eta = eta_u(x.reshape(-1, k, 2))
     gap = abs(etas[0] - etas[1]) / eta if eta > 0 else 0.0
     return {"samples": x.reshape(-1, k, 2), "chain_mean": x.mean(axis=1), "chain_std": x.std(axis=1, ddof=1),
             "eta": eta, "eta_chains": etas, "gap": float(gap), "rhat": float(info["rhat"]),
-            "dimension": int(info["dimension"])}
+            "dimension": int(info["dimension"]), "per_chain": per_chain}
 
 
 def _distance(x, centre, scale):
@@ -130,4 +150,4 @@ def closed_form_segment_eta():
     return 2.0 / np.sqrt(12.0)
 
 
-__all__ = ["eta_u", "eta_curve", "random_walk", "uniform_sample", "centrality", "closed_form_segment_eta"]
+__all__ = ["eta_u", "eta_curve", "random_walk", "uniform_sample", "chains_agree", "MIXED_GAP", "MIXED_RHAT", "centrality", "closed_form_segment_eta"]

@@ -33,6 +33,8 @@ RELATIONS = [
     ("fig4_pile", ("tolerance_study", "runs"), ("ensemble", "runs"), "<=",
      "the tolerance study reruns members of the ensemble"),
     ("fig5_governing", ("flows", "scan_every"), ("flows", "duration"), "<=", "a flow is scanned at least once"),
+    ("fig5_governing", ("uniform", "per_chain"), ("uniform", "max_per_chain"), "<=",
+     "chains that do not agree grow from per_chain up to max_per_chain"),
 ]
 # pairs named <x>_min/<x>_max whose bounds may coincide (a degenerate but valid range)
 EQUAL_ALLOWED = ("radius",)
