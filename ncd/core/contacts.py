@@ -131,7 +131,7 @@ def _assemble(pos, radius, nm, n_disc, a, b, shift, wall_gap, wall_normal, alert
                 gap[c], arm_a[c], arm_b[c] = wall_gap[k, i], radius[i], 0.0
                 c += 1
     key = pair_key(A, B, n_disc)
-    order = np.argsort(key, kind="mergesort")
+    order = key_order(A, key, n_disc, n_walls)
     out_normal = np.empty((n, 2))
     point = np.empty((n, 2))
     law = np.empty((n, 3))
@@ -145,6 +145,38 @@ def _assemble(pos, radius, nm, n_disc, a, b, shift, wall_gap, wall_normal, alert
         law[m, 0], law[m, 1], law[m, 2] = laws[first], laws[first + 1], laws[first + 2]
     return (A[order], B[order], out_normal, point, gap[order], arm_a[order], arm_b[order], sh[order],
             key[order], law[:, 0].copy(), law[:, 1].copy(), law[:, 2].copy())
+
+
+@njit(cache=True)
+def key_order(body_a, key, n_disc, n_walls):
+    """``np.argsort(key, kind="mergesort")`` for the keys of :func:`pair_key`, in O(n).
+
+    With fewer than 1024 walls a key orders the contacts by ``body_a``, then by the
+    other body, so a counting sort on ``body_a`` (stable) followed by an insertion
+    sort of each disc's few contacts (stable) gives the same permutation as the
+    merge sort, at a fraction of its cost on every step.  More walls: the merge sort."""
+    n = key.shape[0]
+    if n_walls >= 1024:
+        return np.argsort(key, kind="mergesort")
+    start = np.zeros(n_disc + 1, np.int64)
+    for c in range(n):
+        start[body_a[c] + 1] += 1
+    for i in range(n_disc):
+        start[i + 1] += start[i]
+    fill = start[:-1].copy()
+    order = np.empty(n, np.int64)
+    for c in range(n):
+        order[fill[body_a[c]]] = c
+        fill[body_a[c]] += 1
+    for i in range(n_disc):
+        for m in range(start[i] + 1, start[i + 1]):
+            c = order[m]
+            k = m
+            while k > start[i] and key[order[k - 1]] > key[c]:
+                order[k] = order[k - 1]
+                k -= 1
+            order[k] = c
+    return order
 
 
 @njit(cache=True)
