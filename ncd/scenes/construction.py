@@ -58,7 +58,8 @@ def _kinetic_energy(scene):
     nm = scene.n_mobile
     m = scene.mass[:nm]
     inertia = 0.5 * m * scene.radius[:nm] ** 2
-    return float(0.5 * np.sum(m * np.sum(scene.vel[:nm] ** 2, axis=1)) + 0.5 * np.sum(inertia * scene.spin[:nm] ** 2))
+    v = scene.vel[:nm]
+    return float(0.5 * np.sum(m * (v[:, 0] ** 2 + v[:, 1] ** 2)) + 0.5 * np.sum(inertia * scene.spin[:nm] ** 2))
 
 
 def write_checkpoint(path, cfg, k, scene, born, source, rec, frames, frame_steps, order=None, removed=()):
