@@ -132,19 +132,21 @@ def _assemble(pos, radius, nm, n_disc, a, b, shift, wall_gap, wall_normal, alert
                 c += 1
     key = pair_key(A, B, n_disc)
     order = key_order(A, key, n_disc, n_walls)
-    out_normal = np.empty((n, 2))
-    point = np.empty((n, 2))
-    law = np.empty((n, 3))
+    # one gathering pass in key order (the fields, then the point and the laws)
+    fields = (np.empty(n, np.int64), np.empty(n, np.int64), np.empty((n, 2)), np.empty((n, 2)), np.empty(n),
+              np.empty(n), np.empty(n), np.empty(n), np.empty(n, np.int64), np.empty(n), np.empty(n), np.empty(n))
+    out_a, out_b, out_normal, point, out_gap, out_arm_a, out_arm_b, out_shift, out_key, mu, e_n, e_t = fields
     for m in range(n):
         c = order[m]
+        out_a[m], out_b[m], out_key[m] = A[c], B[c], key[c]
         out_normal[m, 0], out_normal[m, 1] = normal[c, 0], normal[c, 1]
+        out_gap[m], out_arm_a[m], out_arm_b[m], out_shift[m] = gap[c], arm_a[c], arm_b[c], sh[c]
         w = arm_a[c] + 0.5 * gap[c]
         point[m, 0] = pos[A[c], 0] - w * normal[c, 0]
         point[m, 1] = pos[A[c], 1] - w * normal[c, 1]
         first = 3 if B[c] >= nm or B[c] < 0 else 0
-        law[m, 0], law[m, 1], law[m, 2] = laws[first], laws[first + 1], laws[first + 2]
-    return (A[order], B[order], out_normal, point, gap[order], arm_a[order], arm_b[order], sh[order],
-            key[order], law[:, 0].copy(), law[:, 1].copy(), law[:, 2].copy())
+        mu[m], e_n[m], e_t[m] = laws[first], laws[first + 1], laws[first + 2]
+    return fields
 
 
 @njit(cache=True)
