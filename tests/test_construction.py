@@ -4,7 +4,9 @@
   the converged step (the stated per-step accuracy of ``construction.settings``);
 * the source's insertion test against the grains near the source only makes the same
   insertions as against every grain;
-* the 10^4-grain overlay scales the pouring sites as the base width (sqrt(n)).
+* the 10^4-grain overlay scales the pouring sites as the base width (sqrt(n));
+* grains appended to a scene (:func:`ncd.core.scene.add_discs`) give the scene, and the
+  pouring, that rebuilding the whole scene gives, bit for bit; bad new grains are named.
 """
 import copy
 from pathlib import Path
@@ -14,12 +16,14 @@ import pytest
 import yaml
 
 import ncd
-from ncd.core.errors import SimulationError
+from ncd.core.errors import InputError, SimulationError
+from ncd.core.scene import add_discs
 from ncd.dynamics import stepper
 from ncd.figures import history
 from ncd.pipeline.workflow import settings as solver_settings
 from ncd.scenes import construction, sources
 from ncd.scenes.construction import build
+from ncd.scenes.pile import add_to_pile
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -123,3 +127,68 @@ def test_large_overlay_scales_the_sources_with_the_base_width():
     for key in ("inlet_speed", "drop_height_d", "insert_every", "rows"):
         assert key not in large.get("source", {})            # the rest of the schedule is that of 10^3 grains
     assert "h" not in large and "settings" not in large.get("construction", {})
+
+
+def scene_fields(scene):
+    return {k: v for k, v in vars(scene).items() if k not in ("prev_keys", "prev_impulse")}
+
+
+@pytest.mark.parametrize("period", [None, 0.05])
+def test_appended_discs_give_the_scene_of_all_discs(period):
+    rng = np.random.default_rng(5)
+    pos = np.column_stack([np.arange(12) * 3e-3 + 1e-3, rng.uniform(2e-3, 3e-3, 12)])
+    radius = rng.uniform(0.8e-3, 1.2e-3, 12)
+    vel, spin, angle = rng.normal(size=(12, 2)), rng.normal(size=12), rng.normal(size=12)
+    kw = dict(obstacle_pos=[[0.0, 0.0], [0.03, 0.0]], obstacle_radius=[1e-3, 1.1e-3], mu=0.4, mu_obstacle=0.6,
+              walls=[((0.0, -1e-3), (0.0, 1.0))], period=period, overlap_tolerance=0.25)
+    whole = ncd.make_scene(pos, radius, 1000.0, vel=vel, spin=spin, angle=angle, **kw)
+    part = ncd.make_scene(pos[:8], radius[:8], 1000.0, vel=vel[:8], spin=spin[:8], angle=angle[:8], **kw)
+    part.time = 0.25
+    grown = add_discs(part, pos[8:], radius[8:], 1000.0, vel=vel[8:], spin=spin[8:], angle=angle[8:],
+                      overlap_tolerance=0.25)
+    whole.time = 0.25
+    a, b = scene_fields(whole), scene_fields(grown)
+    assert a.keys() == b.keys()
+    for k in a:
+        assert type(a[k]) is type(b[k]) and np.array_equal(a[k], b[k]), k
+        if isinstance(a[k], np.ndarray):
+            assert a[k].dtype == b[k].dtype and np.array_equal(np.signbit(a[k]), np.signbit(b[k])), k
+    with pytest.raises(InputError, match="radius"):
+        add_discs(part, pos[8:], -radius[8:], 1000.0)
+    with pytest.raises(InputError, match="vel"):
+        add_discs(part, pos[8:], radius[8:], 1000.0, vel=np.zeros((3, 2)))
+    with pytest.raises(InputError, match="pos"):
+        add_discs(part, [[np.nan, 0.0]], 1e-3, 1000.0)
+    with pytest.raises(InputError, match="overlap"):
+        add_discs(part, pos[7:8] + [radius[7], 0.0], radius[7:8], 1000.0, overlap_tolerance=0.25)
+    with pytest.raises(InputError, match="scene"):
+        add_discs("scene", pos[8:], radius[8:], 1000.0)
+
+
+def test_pouring_by_appending_grains_is_the_pouring_by_rebuilding():
+    cfg = config(60, 240)
+    ground = history.make_ground(cfg, history.member_rng(0, cfg["root_seed"], "ground"))
+    factory = lambda p, r, v, w, a: history.pile_scene(cfg, p, r, *ground, vel=v, spin=w, angle=a)  # noqa: E731
+    out = []
+    for grow in (None, lambda s, p, r, v: add_to_pile(cfg, s, p, r, v)):
+        src = history.PointSource(cfg, history.member_rng(0, cfg["root_seed"], "point"),
+                                  float(np.mean(ground[1])), history.grain_radii(cfg, 0))
+        box = {}
+        real = construction.step
+
+        def keep(scene, *a, **k):
+            box["scene"] = scene
+            return real(scene, *a, **k)
+
+        construction.step = keep
+        try:
+            with pytest.raises(SimulationError, match="not at rest"):
+                build(cfg, ground, src, factory, add_grains=grow)
+        finally:
+            construction.step = real
+        out.append(box["scene"])
+    a, b = out
+    assert 20 < a.n_mobile == b.n_mobile
+    for k in ("pos", "vel", "spin", "angle", "radius", "mass", "inv_mass", "inv_inertia", "prev_keys", "prev_impulse"):
+        assert np.array_equal(getattr(a, k), getattr(b, k)), k
+    assert a.time == b.time

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import ncd
-from ncd.core.contacts import detect_contacts, h_matrix, local_velocity
+from ncd.core.contacts import detect_contacts, h_matrix, key_order, local_velocity, pair_key
 from ncd.core.detection import disc_pairs
 from ncd.solver.single_contact import NO_CONTACT, SLIDE_BACKWARD, SLIDE_FORWARD, STICK, solve_single_contact
 
@@ -473,6 +473,22 @@ def test_grid_detection_equals_brute_force(period):
     d = pos[a] - pos[b]
     d[:, 0] -= shift
     assert np.all(np.hypot(d[:, 0], d[:, 1]) <= radius[a] + radius[b] + alert + 1e-12)
+
+
+def test_contact_order_is_the_merge_sort_of_the_pair_keys():
+    """The counting sort of the contacts by body pair gives numpy's stable merge sort
+    permutation, repeated pairs included; with 1024 walls or more (keys of one disc
+    then reach the next disc's) it is the merge sort itself."""
+    rng = np.random.default_rng(3)
+    for trial in range(400):
+        n_disc = int(rng.integers(1, 50))
+        n_mobile = int(rng.integers(1, n_disc + 1))
+        n_walls = int(rng.integers(0, 4)) if trial % 5 else int(rng.integers(1020, 1030))
+        n = int(rng.integers(0, 150))
+        a = rng.integers(0, n_mobile, n)
+        b = rng.integers(-n_walls, n_disc, n)
+        key = pair_key(a, b, n_disc)
+        assert np.array_equal(key_order(a, key, n_disc, n_walls), np.argsort(key, kind="mergesort")), trial
 
 
 def test_periodic_contact_across_the_seam_in_a_step():

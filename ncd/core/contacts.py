@@ -131,20 +131,54 @@ def _assemble(pos, radius, nm, n_disc, a, b, shift, wall_gap, wall_normal, alert
                 gap[c], arm_a[c], arm_b[c] = wall_gap[k, i], radius[i], 0.0
                 c += 1
     key = pair_key(A, B, n_disc)
-    order = np.argsort(key, kind="mergesort")
-    out_normal = np.empty((n, 2))
-    point = np.empty((n, 2))
-    law = np.empty((n, 3))
+    order = key_order(A, key, n_disc, n_walls)
+    # one gathering pass in key order (the fields, then the point and the laws)
+    fields = (np.empty(n, np.int64), np.empty(n, np.int64), np.empty((n, 2)), np.empty((n, 2)), np.empty(n),
+              np.empty(n), np.empty(n), np.empty(n), np.empty(n, np.int64), np.empty(n), np.empty(n), np.empty(n))
+    out_a, out_b, out_normal, point, out_gap, out_arm_a, out_arm_b, out_shift, out_key, mu, e_n, e_t = fields
     for m in range(n):
         c = order[m]
+        out_a[m], out_b[m], out_key[m] = A[c], B[c], key[c]
         out_normal[m, 0], out_normal[m, 1] = normal[c, 0], normal[c, 1]
+        out_gap[m], out_arm_a[m], out_arm_b[m], out_shift[m] = gap[c], arm_a[c], arm_b[c], sh[c]
         w = arm_a[c] + 0.5 * gap[c]
         point[m, 0] = pos[A[c], 0] - w * normal[c, 0]
         point[m, 1] = pos[A[c], 1] - w * normal[c, 1]
         first = 3 if B[c] >= nm or B[c] < 0 else 0
-        law[m, 0], law[m, 1], law[m, 2] = laws[first], laws[first + 1], laws[first + 2]
-    return (A[order], B[order], out_normal, point, gap[order], arm_a[order], arm_b[order], sh[order],
-            key[order], law[:, 0].copy(), law[:, 1].copy(), law[:, 2].copy())
+        mu[m], e_n[m], e_t[m] = laws[first], laws[first + 1], laws[first + 2]
+    return fields
+
+
+@njit(cache=True)
+def key_order(body_a, key, n_disc, n_walls):
+    """``np.argsort(key, kind="mergesort")`` for the keys of :func:`pair_key`, in O(n).
+
+    With fewer than 1024 walls a key orders the contacts by ``body_a``, then by the
+    other body, so a counting sort on ``body_a`` (stable) followed by an insertion
+    sort of each disc's few contacts (stable) gives the same permutation as the
+    merge sort, at a fraction of its cost on every step.  More walls: the merge sort."""
+    n = key.shape[0]
+    if n_walls >= 1024:
+        return np.argsort(key, kind="mergesort")
+    start = np.zeros(n_disc + 1, np.int64)
+    for c in range(n):
+        start[body_a[c] + 1] += 1
+    for i in range(n_disc):
+        start[i + 1] += start[i]
+    fill = start[:-1].copy()
+    order = np.empty(n, np.int64)
+    for c in range(n):
+        order[fill[body_a[c]]] = c
+        fill[body_a[c]] += 1
+    for i in range(n_disc):
+        for m in range(start[i] + 1, start[i + 1]):
+            c = order[m]
+            k = m
+            while k > start[i] and key[order[k - 1]] > key[c]:
+                order[k] = order[k - 1]
+                k -= 1
+            order[k] = c
+    return order
 
 
 @njit(cache=True)

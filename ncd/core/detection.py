@@ -97,14 +97,25 @@ def _grid_pairs(pos, radius, n_mobile, alert, period, cell, out_a, out_b, out_sh
     return count
 
 
+@njit(cache=True)
+def _extent(pos, radius):
+    """``x_min, x_max, y_min, y_max`` of ``pos`` and the largest radius."""
+    x0, x1, y0, y1 = np.inf, -np.inf, np.inf, -np.inf
+    for i in range(pos.shape[0]):
+        x0, x1 = min(x0, pos[i, 0]), max(x1, pos[i, 0])
+        y0, y1 = min(y0, pos[i, 1]), max(y1, pos[i, 1])
+    return x0, x1, y0, y1, radius.max()
+
+
 def disc_pairs(pos, radius, n_mobile, alert=0.0, period=0.0):
     """Candidate disc pairs within ``alert``: arrays ``(a, b, shift_b)``."""
     n = len(radius)
-    cell = 2.0 * radius.max() + alert
+    x0, x1, y0, y1, rmax = _extent(pos, radius)
+    cell = 2.0 * rmax + alert
     if period <= 0.0:
-        # keep the grid about as large as the number of discs
-        span = np.ptp(pos, axis=0)
-        cell = max(cell, float(np.sqrt((span[0] + cell) * (span[1] + cell) / (4.0 * n + 16.0))))
+        # keep the grid about as large as the number of discs; the span from one
+        # pass of _extent (np.ptp's max - min, the same bits, without its overhead)
+        cell = max(cell, float(np.sqrt((x1 - x0 + cell) * (y1 - y0 + cell) / (4.0 * n + 16.0))))
     cap = 4 * n + 16
     while True:
         a = np.empty(cap, np.int64)
@@ -127,16 +138,6 @@ def disc_pairs(pos, radius, n_mobile, alert=0.0, period=0.0):
 
 # ------------------------------------------------------------ argument checks
 MAX_GRID_CELLS = 1e7      # cells of the contact detection grid (8 bytes each)
-
-
-@njit(cache=True)
-def _extent(pos, radius):
-    """``x_min, x_max, y_min, y_max`` of ``pos`` and the largest radius."""
-    x0, x1, y0, y1 = np.inf, -np.inf, np.inf, -np.inf
-    for i in range(pos.shape[0]):
-        x0, x1 = min(x0, pos[i, 0]), max(x1, pos[i, 0])
-        y0, y1 = min(y0, pos[i, 1]), max(y1, pos[i, 1])
-    return x0, x1, y0, y1, radius.max()
 
 
 def check_detection_args(s, alert, pos):

@@ -4,7 +4,7 @@ import numpy as np
 from ncd.core import validate
 from ncd.core.contacts import detect_contacts
 from ncd.core.errors import InputError
-from ncd.core.model import Scene, check_period
+from ncd.core.model import Scene, check_period, check_scene
 
 
 def make_scene(pos, radius, density=1.0, *, obstacle_pos=None, obstacle_radius=None,
@@ -101,6 +101,56 @@ def make_scene(pos, radius, density=1.0, *, obstacle_pos=None, obstacle_radius=N
     )
     check_overlaps(scene, overlap_tolerance)
     return scene
+
+
+def add_discs(scene, pos, radius, density=1.0, *, vel=None, spin=None, angle=None, overlap_tolerance=1e-2):
+    """``scene`` with mobile discs appended after its own: a new scene, equal to the
+    :func:`make_scene` of all the discs (obstacles, walls, laws kept; its time too).
+
+    A pouring adds a few grains to hundreds every few steps: only the new discs are
+    validated and given masses (the same formulas, hence the same bits for the old ones,
+    whose arrays are taken from ``scene``), while the overlap check covers every disc as
+    :func:`make_scene` does.  The warm-start memory is not carried (its keys depend on
+    the disc count: :func:`ncd.scenes.construction.carry_warm` re-encodes it)."""
+    check_scene(scene, state=True)
+    pos = validate.array("pos", pos, (None, 2))
+    k = len(pos)
+    radius = validate.per_item("radius", radius, k, 0.0, lo_open=True)
+    density = validate.per_item("density", density, k, 0.0, lo_open=True)
+    validate.real("overlap_tolerance", overlap_tolerance, 0.0, allow_inf=True)
+    vel = np.zeros((k, 2)) if vel is None else validate.array("vel", vel, (k, 2))
+    spin = np.zeros(k) if spin is None else validate.per_item("spin", spin, k)
+    angle = np.zeros(k) if angle is None else validate.per_item("angle", angle, k)
+    if k and scene.period > 0:
+        check_period("scene.period", scene.period, max(float(scene.radius.max()), float(radius.max())))
+        pos = pos.copy()
+        pos[:, 0] %= scene.period
+    with np.errstate(all="ignore"):
+        mass = density * np.pi * radius ** 2
+        inertia = 0.5 * mass * radius ** 2
+        bad = ~(np.isfinite(mass) & np.isfinite(inertia) & (mass > 0) & (inertia > 0) & np.isfinite(1.0 / inertia))
+    if np.any(bad):
+        i = int(np.argmax(bad))
+        raise InputError(f"new disc {i}: mass {mass[i]:.3g} and inertia {inertia[i]:.3g} from density "
+                         f"{density[i]} and radius {radius[i]} must be finite and > 0 (double precision)")
+    if k and np.abs(pos).max() > 1e150:
+        raise InputError(f"coordinates must be below 1e150 in magnitude (contact geometry squares them); "
+                         f"got {np.abs(pos).max():.3g}")
+    nm = scene.n_mobile
+
+    def insert(old, new):
+        return np.concatenate([old[:nm], new, old[nm:]])
+
+    out = Scene(
+        pos=insert(scene.pos, pos), radius=insert(scene.radius, radius),
+        inv_mass=insert(scene.inv_mass, 1.0 / mass), inv_inertia=insert(scene.inv_inertia, 2.0 / (mass * radius ** 2)),
+        mass=insert(scene.mass, mass), n_mobile=nm + k, wall_point=scene.wall_point, wall_normal=scene.wall_normal,
+        gravity=scene.gravity, mu=scene.mu, mu_obstacle=scene.mu_obstacle, e_n=scene.e_n, e_t=scene.e_t,
+        e_n_obstacle=scene.e_n_obstacle, e_t_obstacle=scene.e_t_obstacle, period=scene.period,
+        angle=insert(scene.angle, angle), vel=insert(scene.vel, vel), spin=insert(scene.spin, spin),
+        time=scene.time)
+    check_overlaps(out, overlap_tolerance)
+    return out
 
 
 def check_overlaps(scene, tolerance):

@@ -204,7 +204,10 @@ def kinetic_energy(scene):
     nm = scene.n_mobile
     m = scene.mass[:nm]
     inertia = 0.5 * m * scene.radius[:nm] ** 2
-    return float(0.5 * np.sum(m * np.sum(scene.vel[:nm] ** 2, axis=1)) + 0.5 * np.sum(inertia * scene.spin[:nm] ** 2))
+    v = scene.vel[:nm]
+    # v_x^2 + v_y^2: the bits of np.sum(v ** 2, axis=1), whose reduction over rows of two
+    # costs more than the rest of the energy
+    return float(0.5 * np.sum(m * (v[:, 0] ** 2 + v[:, 1] ** 2)) + 0.5 * np.sum(inertia * scene.spin[:nm] ** 2))
 
 
 # ------------------------------------------------------------ argument checks

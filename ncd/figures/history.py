@@ -12,7 +12,7 @@ import numpy as np
 import xarray as xr
 
 from ncd.scenes.construction import add_frames, build
-from ncd.scenes.pile import construction_dataset, free_surface, make_ground, pile_scene
+from ncd.scenes.pile import add_to_pile, construction_dataset, free_surface, make_ground, pile_scene
 from ncd.scenes.sources import PointSource, RainSource, mean_diameter
 
 HISTORIES = ("point", "rain")
@@ -85,7 +85,8 @@ def construct(cfg, history, member, point_half_width=None, log=None, checkpoint=
         key["grains"] = {**cfg["grains"], "n": limit}
     scene, rec, eq, frames = build(key, ground, source, factory, log, checkpoint=checkpoint,
                                    checkpoint_every=c["checkpoint_every"], frame_every=c["frame_every"],
-                                   drop_below=drop, info=info)
+                                   drop_below=drop, info=info,
+                                   add_grains=lambda s, p, r, v: add_to_pile(cfg, s, p, r, v))
     return scene, rec, ground, eq, frames
 
 

@@ -58,7 +58,8 @@ def _kinetic_energy(scene):
     nm = scene.n_mobile
     m = scene.mass[:nm]
     inertia = 0.5 * m * scene.radius[:nm] ** 2
-    return float(0.5 * np.sum(m * np.sum(scene.vel[:nm] ** 2, axis=1)) + 0.5 * np.sum(inertia * scene.spin[:nm] ** 2))
+    v = scene.vel[:nm]
+    return float(0.5 * np.sum(m * (v[:, 0] ** 2 + v[:, 1] ** 2)) + 0.5 * np.sum(inertia * scene.spin[:nm] ** 2))
 
 
 def write_checkpoint(path, cfg, k, scene, born, source, rec, frames, frame_steps, order=None, removed=()):
@@ -100,13 +101,16 @@ def read_checkpoint(path, cfg):
 
 
 def build(cfg, ground, source, scene_factory, log=None, log_every=10.0, checkpoint=None,
-          checkpoint_every=0, frame_every=0, drop_below=None, info=None, pour_limit=None):
+          checkpoint_every=0, frame_every=0, drop_below=None, info=None, pour_limit=None, add_grains=None):
     """Pour ``grains.n`` discs from ``source`` onto ``ground`` and step until at rest.
 
     Returns ``(scene, record, eq, (frame_steps, frames))``: final scene, per-step record, the
     warm-started :class:`ncd.EquilibriumResult` and :data:`FRAME` every ``frame_every`` steps.
     ``checkpoint`` saves and resumes; ``drop_below`` removes grains off a finite base (pouring
-    until ``grains.n`` stand or ``pour_limit`` are poured); ``info`` gets ``order``, ``removed``."""
+    until ``grains.n`` stand or ``pour_limit`` are poured); ``info`` gets ``order``, ``removed``.
+    ``add_grains(scene, pos, radius, vel)``, if given, returns ``scene`` with new grains at rest
+    in angle and spin appended, the scene ``scene_factory`` would build from all the grains
+    (:func:`ncd.scenes.pile.add_to_pile`): a pouring then validates only the new grains."""
     c = cfg["construction"]
     d = mean_diameter(cfg)
     h = cfg["h"]
@@ -151,10 +155,13 @@ def build(cfg, ground, source, scene_factory, log=None, log_every=10.0, checkpoi
             source.update_height(st[0], st[1], st[2], k - born >= min_age)
             p, r = source.draw(st[0], st[1], min(n_target - nm, pour_limit - poured))
             if len(r):
-                vel = np.vstack([st[2], source.velocities(len(r))])
-                new = scene_factory(np.vstack([st[0], p]), np.concatenate([st[1], r]), vel,
-                                    np.concatenate([st[3], np.zeros(len(r))]),
-                                    np.concatenate([st[4], np.zeros(len(r))]))
+                v = source.velocities(len(r))
+                if scene is not None and add_grains is not None:
+                    new = add_grains(scene, p, r, v)
+                else:
+                    new = scene_factory(np.vstack([st[0], p]), np.concatenate([st[1], r]), np.vstack([st[2], v]),
+                                        np.concatenate([st[3], np.zeros(len(r))]),
+                                        np.concatenate([st[4], np.zeros(len(r))]))
                 if scene is not None:
                     new.time = scene.time
                     carry_warm(scene, new)

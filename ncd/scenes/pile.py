@@ -13,7 +13,7 @@ import xarray as xr
 
 from ncd.core.contacts import h_matrix
 from ncd.core.errors import SimulationError
-from ncd.core.scene import make_scene
+from ncd.core.scene import add_discs, make_scene
 from ncd.dynamics.explore import member_rng
 from ncd.dynamics.stepper import prepare_step
 from ncd.io.netcdf import provenance
@@ -48,6 +48,14 @@ def pile_scene(cfg, pos, radius, ground_pos, ground_radius, vel=None, spin=None,
                           overlap_tolerance=c["overlap_tolerance"])
 
 
+def add_to_pile(cfg, scene, pos, radius, vel):
+    """The :func:`pile_scene` of ``scene``'s grains and new grains (positions, radii,
+    velocities; at rest in angle and spin) appended after them, built from ``scene``
+    without validating its grains again (:func:`ncd.core.scene.add_discs`)."""
+    return add_discs(scene, pos, radius, cfg["grains"]["density"], vel=vel,
+                     overlap_tolerance=cfg["construction"]["overlap_tolerance"])
+
+
 def construct(cfg, log=None, log_every=10.0, checkpoint=None, checkpoint_every=0, frame_every=0):
     """Pour ``grains.n`` discs from the localized source and step until at rest (the loop is
     :func:`ncd.scenes.construction.build`).
@@ -60,7 +68,7 @@ def construct(cfg, log=None, log_every=10.0, checkpoint=None, checkpoint_every=0
     source = Source(cfg, rng, float(np.mean(ground[1])))
     factory = lambda p, r, v, w, a: pile_scene(cfg, p, r, *ground, vel=v, spin=w, angle=a)  # noqa: E731
     scene, rec, eq, frames = build(cfg, ground, source, factory, log, log_every, checkpoint, checkpoint_every,
-                                   frame_every)
+                                   frame_every, add_grains=lambda s, p, r, v: add_to_pile(cfg, s, p, r, v))
     return (scene, rec, ground, eq) + ((frames,) if frame_every > 0 else ())
 
 

@@ -58,11 +58,13 @@ class _Source:
     def _try(self, x, r, pos, radius, new_p, new_r, dy=0.0):
         """Insert a grain of radius ``r`` at ``(x, height + dy)`` if it clears every grain by 0.05 d."""
         clear = 0.05 * self.d
-        p = np.array([x, self.height + dy])
-        ok = len(radius) == 0 or np.min(np.hypot(*(pos - p).T) - radius - r) > clear
-        ok = ok and all(np.hypot(*(q - p)) > r + rq + clear for q, rq in zip(new_p, new_r))
+        y = self.height + dy
+        # column by column and scalar by scalar: the distances of np.hypot(*(pos - p).T),
+        # bit for bit, without a temporary (n, 2) array on each of the many attempts
+        ok = len(radius) == 0 or np.min(np.hypot(pos[:, 0] - x, pos[:, 1] - y) - radius - r) > clear
+        ok = ok and all(np.hypot(q[0] - x, q[1] - y) > r + rq + clear for q, rq in zip(new_p, new_r))
         if ok:
-            new_p.append(p)
+            new_p.append(np.array([x, y]))
             new_r.append(r)
             if self.radii is not None:
                 self.taken += 1
