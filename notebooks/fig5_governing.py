@@ -41,8 +41,8 @@
 # it as it moves a disc, and its vertical equilibrium is a row of $A$. Its contacts are
 # frictionless, so that it receives vertical forces only and translates along its normal
 # exactly; no solver kernel changes. A packing is at rest when the plate is slow and the
-# one-step test from rest gives $u_f = 0$; that test, finished on its contact statuses,
-# gives the exact reference forces. The middle slice is then one problem
+# one-step test from rest gives $u_f = 0$; that test, finished on its contact statuses and
+# made exact on its active Coulomb rows, gives the reference forces. The middle slice is then one problem
 # $H r + F = 0$, $r \in C$: unknowns the forces between two slice discs, $F$ the
 # boundary forces of the reference. On it: the exact range of every force component over
 # $A \cap C$ and $\dim(A \cap C)$ by LP (`governing_exact`), with the **exact range ratio**

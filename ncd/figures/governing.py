@@ -293,6 +293,7 @@ def analyse(builds, j, cfg, mu, rng_walk, rng_of):
     sl = slice_of(cell, contacts, forces, p, exact)
     out = exact_measures(sl.H, sl.F, sl.mu, width_tol=e["width_tol"], slack_tol=e["slack_tol"],
                          feas_tol=e["feas_tol"])
+    out["rest_exact"] = float(exact)
     out["bounded_cell"] = plates_bounded(cell, contacts)
     out["z"], out["n_nonrattlers"] = coordination(sl, cell, contacts, forces, float(builds.build_mu[j]) > 0)
     out["n_slice"] = len(sl.discs)
@@ -330,7 +331,9 @@ SCALARS = {"n_contacts": "contacts kappa in the slice", "rank_H": "rank of the s
            "walk_distance": "mean |walk sample - centre| / <|F|>", "uniform_distance": "mean |uniform sample - "
            "centre| / <|F|>", "walk_ok": "random-walk samples that are points of A ∩ C",
            "mixed": "1: the two uniform chains agree (eta_U gap <= 0.3, R-hat <= 1.2)",
-           "uniform_per_chain": "points per uniform chain (longer where the first chains did not agree)"}
+           "uniform_per_chain": "points per uniform chain (longer where the first chains did not agree)",
+           "rest_exact": "1: the rest forces made exact on their active Coulomb rows (0: the slice's loads "
+           "are those its reference forces balance, see exact_rest)"}
 
 
 def analysis_shard(builds, cfg, shard, n_shards, progress=None):
@@ -375,7 +378,7 @@ def _dataset(rows, table, sel, builds, cfg):
         r["walk_ok"] = int(r["ok"].sum())
         r.setdefault("mixed", 0.0)
     scal = {q: np.array([r.get(q, np.nan) for r in rows], float) for q in SCALARS}
-    for q in ("bounded", "bounded_cell", "mixed"):
+    for q in ("bounded", "bounded_cell", "mixed", "rest_exact"):
         scal[q] = scal[q].astype(np.int8)
     data = {q: _var("packing", v, "N" if q == "scale" else "1", SCALARS[q]) for q, v in scal.items()}
     b = table["build"][sel]

@@ -16,7 +16,7 @@ from scipy import stats
 
 from ncd.core.verdict import DIFFERS, NOT_COMPUTED, NOT_TESTED, REPRODUCED, Verdict
 from ncd.figures.governing import eta_table, mixed_only
-from ncd.figures.governing_unger import eta_u
+from ncd.figures.governing_unger import MIXED_GAP, MIXED_RHAT, eta_u
 
 DATA = "fig5_governing/packings.nc"
 PEAK_MU = 0.1              # Unger et al.: maximum near mu = 0.1
@@ -121,6 +121,11 @@ def mean_settling(ds, kind=0):
     return float(worst)
 
 
+def _count(ds, var):
+    """Analyses where ``var`` is 1 (all of them in data written before ``var`` existed)."""
+    return int(ds[var].sum()) if var in ds else ds.sizes["packing"]
+
+
 def _span(values, default):
     """``"a"`` or ``"a–b"`` of the finite values (``default`` when there are none)."""
     v = np.asarray(values, float)
@@ -132,7 +137,7 @@ def _span(values, default):
 def study_summary(ds, cfg):
     """One paragraph of the study's numbers: packings, slices, dimensions, boundedness, walk
     and uniform-sample acceptance (the page's first measured paragraph)."""
-    p, w, u = cfg["packings"], cfg["walk"], cfg["uniform"]
+    p, u = cfg["packings"], cfg["uniform"]
     dim = ds.dim_AC_rank.values
     others = ", ".join(f"{m:.3g}" for m in ds.mu.values[ds.mixed.values == 0]) or "none"
     return (
@@ -144,12 +149,14 @@ def study_summary(ds, cfg):
         f"every μ). The middle slice of {p['slice_radii']} R holds {int(ds.n_slice.min())}–{int(ds.n_slice.max())} "
         f"discs and {int(ds.n_contacts.min())}–{int(ds.n_contacts.max())} contacts; dim(A∩C) is "
         f"{int(dim.min())}–{int(dim.max())} (rank count and LP agree on {int((ds.dim_AC_lp == ds.dim_AC_rank).sum())} "
-        f"of {ds.sizes['packing']} analyses); the slice's A ∩ C is bounded in {int(ds.bounded.sum())} and the whole "
-        f"cell's in {int(ds.bounded_cell.sum())} of them. Random walk: {w['samples']} rounds per analysis, "
-        f"{int(ds.walk_ok.sum() - ds.sizes['packing'])} of {w['samples'] * ds.sizes['packing']} relaxed states "
-        f"points of A ∩ C (a failed round leaves the walk in place). Uniform sample: 2 chains of {_span(ds.uniform_per_chain, u['per_chain'])} "
+        f"of {ds.sizes['packing']} analyses); the rest forces are made exact on their active Coulomb rows in "
+        f"{_count(ds, 'rest_exact')} of {ds.sizes['packing']} (the others, where that left C, keep their "
+        f"round-off and the slice takes the loads they balance); the slice's A ∩ C is bounded in {int(ds.bounded.sum())} and the whole "
+        f"cell's in {int(ds.bounded_cell.sum())} of them. Random walk: {ds.sizes['sample'] - 1} rounds per analysis, "
+        f"{int(ds.walk_ok.sum() - ds.sizes['packing'])} of {(ds.sizes['sample'] - 1) * ds.sizes['packing']} relaxed states "
+        f"points of A ∩ C (a failed round leaves the walk in place). Uniform sample: 2 chains of {_span(ds.get('uniform_per_chain', []), u['per_chain'])} "
         f"points from dispersed starts (4 times longer, up to {u.get('max_per_chain', u['per_chain'])}, where "
-        "shorter chains did not agree); they agree (η_U within {MIXED_GAP:.0%}, R-hat ≤ {MIXED_RHAT}) on "
+        f"shorter chains did not agree); they agree (η_U within {MIXED_GAP:.0%}, R-hat ≤ {MIXED_RHAT}) on "
         f"{int(ds.mixed.sum())} of {int(ds.bounded.sum())} analyses; the others (at μ = {others}) are left out of "
         "every uniform-sample number below and in the figure.")
 
