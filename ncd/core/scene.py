@@ -7,6 +7,20 @@ from ncd.core.errors import InputError
 from ncd.core.model import Scene, check_period, check_scene
 
 
+def _disc_mass(density, radius, label):
+    """Masses of discs (2-D: ``rho pi r^2``), checked with their inertias ``m r^2 / 2`` to be
+    finite, positive and invertible in double precision; ``label`` names a disc in the error."""
+    with np.errstate(all="ignore"):
+        mass = density * np.pi * radius ** 2
+        inertia = 0.5 * mass * radius ** 2
+        bad = ~(np.isfinite(mass) & np.isfinite(inertia) & (mass > 0) & (inertia > 0) & np.isfinite(1.0 / inertia))
+    if np.any(bad):
+        i = int(np.argmax(bad))
+        raise InputError(f"{label} {i}: mass {mass[i]:.3g} and inertia {inertia[i]:.3g} from density {density[i]} "
+                         f"and radius {radius[i]} must be finite and > 0 (double precision)")
+    return mass
+
+
 def make_scene(pos, radius, density=1.0, *, obstacle_pos=None, obstacle_radius=None,
                walls=(), gravity=(0.0, -9.81), mu=0.5, mu_obstacle=None,
                e_n=0.0, e_t=0.0, e_n_obstacle=None, e_t_obstacle=None, period=None,
@@ -70,14 +84,7 @@ def make_scene(pos, radius, density=1.0, *, obstacle_pos=None, obstacle_radius=N
         opos = opos.copy()
         opos[:, 0] %= period
 
-    with np.errstate(all="ignore"):
-        mass = density * np.pi * radius ** 2
-        inertia = 0.5 * mass * radius ** 2
-        bad = ~(np.isfinite(mass) & np.isfinite(inertia) & (mass > 0) & (inertia > 0) & np.isfinite(1.0 / inertia))
-    if np.any(bad):
-        i = int(np.argmax(bad))
-        raise InputError(f"disc {i}: mass {mass[i]:.3g} and inertia {inertia[i]:.3g} from density {density[i]} "
-                         f"and radius {radius[i]} must be finite and > 0 (double precision)")
+    mass = _disc_mass(density, radius, "disc")
     extent = np.abs(np.vstack([pos, opos])).max()
     if extent > 1e150 or (len(wp) and np.abs(wp).max() > 1e150):
         raise InputError(f"coordinates must be below 1e150 in magnitude (contact geometry squares them); "
@@ -125,14 +132,7 @@ def add_discs(scene, pos, radius, density=1.0, *, vel=None, spin=None, angle=Non
         check_period("scene.period", scene.period, max(float(scene.radius.max()), float(radius.max())))
         pos = pos.copy()
         pos[:, 0] %= scene.period
-    with np.errstate(all="ignore"):
-        mass = density * np.pi * radius ** 2
-        inertia = 0.5 * mass * radius ** 2
-        bad = ~(np.isfinite(mass) & np.isfinite(inertia) & (mass > 0) & (inertia > 0) & np.isfinite(1.0 / inertia))
-    if np.any(bad):
-        i = int(np.argmax(bad))
-        raise InputError(f"new disc {i}: mass {mass[i]:.3g} and inertia {inertia[i]:.3g} from density "
-                         f"{density[i]} and radius {radius[i]} must be finite and > 0 (double precision)")
+    mass = _disc_mass(density, radius, "new disc")
     if k and np.abs(pos).max() > 1e150:
         raise InputError(f"coordinates must be below 1e150 in magnitude (contact geometry squares them); "
                          f"got {np.abs(pos).max():.3g}")
