@@ -41,6 +41,11 @@ def pouring():
     """A point pile still being poured (300 grains, stopped after 700 steps)."""
     cfg = config()
     ground = history.make_ground(cfg, history.member_rng(0, cfg["root_seed"], "ground"))
+    return cfg, poured_scene(cfg, ground)
+
+
+def poured_scene(cfg, ground, add_grains=None):
+    """The scene of the last step of a point pour stopped by ``max_steps`` before rest."""
     src = history.PointSource(cfg, history.member_rng(0, cfg["root_seed"], "point"), float(np.mean(ground[1])),
                               history.grain_radii(cfg, 0))
     box = {}
@@ -54,10 +59,10 @@ def pouring():
     try:
         with pytest.raises(SimulationError, match="not at rest"):
             build(cfg, ground, src, lambda p, r, v, w, a: history.pile_scene(cfg, p, r, *ground, vel=v, spin=w,
-                                                                             angle=a))
+                                                                             angle=a), add_grains=add_grains)
     finally:
         construction.step = real
-    return cfg, box["scene"]
+    return box["scene"]
 
 
 def test_construction_step_tolerance_bounds_the_velocity_error(pouring):
@@ -168,26 +173,7 @@ def test_appended_discs_give_the_scene_of_all_discs(period):
 def test_pouring_by_appending_grains_is_the_pouring_by_rebuilding():
     cfg = config(60, 240)
     ground = history.make_ground(cfg, history.member_rng(0, cfg["root_seed"], "ground"))
-    factory = lambda p, r, v, w, a: history.pile_scene(cfg, p, r, *ground, vel=v, spin=w, angle=a)  # noqa: E731
-    out = []
-    for grow in (None, lambda s, p, r, v: add_to_pile(cfg, s, p, r, v)):
-        src = history.PointSource(cfg, history.member_rng(0, cfg["root_seed"], "point"),
-                                  float(np.mean(ground[1])), history.grain_radii(cfg, 0))
-        box = {}
-        real = construction.step
-
-        def keep(scene, *a, **k):
-            box["scene"] = scene
-            return real(scene, *a, **k)
-
-        construction.step = keep
-        try:
-            with pytest.raises(SimulationError, match="not at rest"):
-                build(cfg, ground, src, factory, add_grains=grow)
-        finally:
-            construction.step = real
-        out.append(box["scene"])
-    a, b = out
+    a, b = (poured_scene(cfg, ground, grow) for grow in (None, lambda s, p, r, v: add_to_pile(cfg, s, p, r, v)))
     assert 20 < a.n_mobile == b.n_mobile
     for k in ("pos", "vel", "spin", "angle", "radius", "mass", "inv_mass", "inv_inertia", "prev_keys", "prev_impulse"):
         assert np.array_equal(getattr(a, k), getattr(b, k)), k
