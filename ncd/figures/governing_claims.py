@@ -86,12 +86,19 @@ def walk_settling(ds):
     samples / eta_U over all - 1|; returns (median, largest, count)."""
     out = []
     for j in np.nonzero(np.nan_to_num(ds.eta_walk.values) > 0)[0]:
-        ok = ds.walk_point.values[j] == 1
-        k = int(ds.n_contacts[j])
-        f = np.stack([ds.walk_n.values[j][ok][:, :k], ds.walk_t.values[j][ok][:, :k]], axis=-1)
+        f = walk_forces(ds, j)
         if len(f) >= 6:
             out.append(abs(eta_u(f[: len(f) // 2]) / eta_u(f) - 1.0))
     return (float(np.median(out)), float(np.max(out)), len(out)) if out else (np.nan, np.nan, 0)
+
+
+def walk_forces(ds, j, count=None):
+    """Accepted random-walk states of analysis ``j`` (samples, contacts, 2), over its first
+    ``count`` rounds (all by default), the contact padding left out."""
+    stop = None if count is None else count + 1
+    ok = ds.walk_point.values[j, :stop] == 1
+    k = int(ds.n_contacts[j])
+    return np.stack([ds.walk_n.values[j, :stop][ok][:, :k], ds.walk_t.values[j, :stop][ok][:, :k]], axis=-1)
 
 
 def walk_eta_at(ds, j, count):
@@ -99,9 +106,7 @@ def walk_eta_at(ds, j, count):
     determinate slice, as in :func:`ncd.figures.governing.analyse`)."""
     if int(ds.dim_AC_rank[j]) == 0:
         return 0.0
-    ok = ds.walk_point.values[j, : count + 1] == 1
-    k = int(ds.n_contacts[j])
-    f = np.stack([ds.walk_n.values[j, : count + 1][ok][:, :k], ds.walk_t.values[j, : count + 1][ok][:, :k]], axis=-1)
+    f = walk_forces(ds, j, count)
     return eta_u(f) if len(f) > 1 else np.nan
 
 
@@ -119,11 +124,6 @@ def mean_settling(ds, kind=0):
         if full > 0:
             worst = max(worst, abs(half / full - 1.0))
     return float(worst)
-
-
-def _count(ds, var):
-    """Analyses where ``var`` is 1 (all of them in data written before ``var`` existed)."""
-    return int(ds[var].sum()) if var in ds else ds.sizes["packing"]
 
 
 def _span(values, default):
@@ -150,11 +150,11 @@ def study_summary(ds, cfg):
         f"discs and {int(ds.n_contacts.min())}–{int(ds.n_contacts.max())} contacts; dim(A∩C) is "
         f"{int(dim.min())}–{int(dim.max())} (rank count and LP agree on {int((ds.dim_AC_lp == ds.dim_AC_rank).sum())} "
         f"of {ds.sizes['packing']} analyses); the rest forces are made exact on their active Coulomb rows in "
-        f"{_count(ds, 'rest_exact')} of {ds.sizes['packing']} (the others, where that left C, keep their "
+        f"{int(ds.rest_exact.sum())} of {ds.sizes['packing']} (the others, where that left C, keep their "
         f"round-off and the slice takes the loads they balance); the slice's A ∩ C is bounded in {int(ds.bounded.sum())} and the whole "
         f"cell's in {int(ds.bounded_cell.sum())} of them. Random walk: {ds.sizes['sample'] - 1} rounds per analysis, "
         f"{int(ds.walk_ok.sum() - ds.sizes['packing'])} of {(ds.sizes['sample'] - 1) * ds.sizes['packing']} relaxed states "
-        f"points of A ∩ C (a failed round leaves the walk in place). Uniform sample: 2 chains of {_span(ds.get('uniform_per_chain', []), u['per_chain'])} "
+        f"points of A ∩ C (a failed round leaves the walk in place). Uniform sample: 2 chains of {_span(ds.uniform_per_chain, u['per_chain'])} "
         f"points from dispersed starts (4 times longer, up to {u.get('max_per_chain', u['per_chain'])}, where "
         f"shorter chains did not agree); they agree (η_U within {MIXED_GAP:.0%}, R-hat ≤ {MIXED_RHAT}) on "
         f"{int(ds.mixed.sum())} of {int(ds.bounded.sum())} analyses; the others (at μ = {others}) are left out of "
@@ -255,5 +255,5 @@ def claim_unger_centrality(results):
                    "unger-centrality", (DATA,))
 
 
-__all__ = ["study_summary", "walk_settling", "walk_eta_at", "mean_settling", "peak", "small_mu_slope", "vanishing", "control_trend", "centrality_summary", "claim_unger_peak",
+__all__ = ["study_summary", "walk_settling", "walk_forces", "walk_eta_at", "mean_settling", "peak", "small_mu_slope", "vanishing", "control_trend", "centrality_summary", "claim_unger_peak",
            "claim_unger_vanishes", "claim_unger_control", "claim_unger_centrality", "PEAK_MU", "Z_ISOSTATIC"]
