@@ -211,16 +211,22 @@ class ForcePolytope:
         return x0, Z, Gz[keep], b[keep], implicit
 
     def uniform_samples(self, rng_of, n_chains, per_chain, thin=None, burn=None, rounds=2, implicit=None,
-                        dispersed=False):
+                        dispersed=False, points=None):
         """Points drawn uniformly from ``A ∩ C`` (forces, shape (n_chains * per_chain, 2 kappa)).
 
         Hit-and-run in the affine hull of ``A ∩ C`` from its Chebyshev centre,
         with directions shaped by the covariance of ``rounds`` pilot chains
-        (any symmetric direction law keeps the uniform law stationary).
+        (any symmetric direction law keeps the uniform law stationary); pilots start
+        at the centre, after a burn-in of 50 d steps.  ``burn``: hit-and-run steps
+        discarded at the start of every chain (default 50 d).
         ``dispersed``: chain ``k`` starts instead 95 % of the way from the centre to the
         vertex maximizing a random direction (drawn from ``rng_of(k)``), so that chains
         that agree have forgotten different starts (a mixing check).  ``implicit``: known
         implicit equalities (:meth:`affine_hull`).
+        ``points``: known points of ``A ∩ C`` (forces, rows, e.g. the vertices found by
+        range LPs) whose covariance, plus the inscribed ball, shapes the first pilot's
+        directions: an isotropic first pilot crawls along a set whose widths span
+        several decades and leaves a covariance no better than its start.
         ``rng_of(k)`` is the generator of chain ``k``; pilots use ``n_chains + r``.
         Returns ``(samples, info)``; ``info`` has the dimension, the implicit
         equalities and the largest Gelman-Rubin R-hat over coordinates.
@@ -250,6 +256,9 @@ class ForcePolytope:
         thin = thin or 4 * d
         burn = burn or 50 * d
         L = np.eye(d) * res.x[-1]
+        if points is not None and len(points) > 1:
+            V = (np.asarray(points, float).reshape(len(points), -1) / self.scale - x0) @ Z
+            L = np.linalg.cholesky(np.atleast_2d(np.cov(V.T)) + res.x[-1] ** 2 * np.eye(d))
 
         def start(rng):
             if not dispersed:
@@ -258,9 +267,8 @@ class ForcePolytope:
                         options=self.highs)
             return y0 + 0.95 * (v.x - y0) if v.status == 0 else y0.copy()
 
-        def chain(rng, n_keep, L):
-            y = start(rng)
-            blocks = [max(burn // thin, 1)] + [min(1000, n_keep - k) for k in range(0, n_keep, 1000)]
+        def chain(rng, n_keep, L, y, n_burn):
+            blocks = [max(n_burn // thin, 1)] + [min(1000, n_keep - k) for k in range(0, n_keep, 1000)]
             keep = []
             for n in blocks:                                  # the first block is burn-in
                 slack = b - Gz @ y                            # fresh slack: no drift
@@ -268,11 +276,15 @@ class ForcePolytope:
                                          rng.uniform(size=n * thin)))
             return np.concatenate(keep[1:])
 
-        for r in range(rounds):
-            pilot = chain(rng_of(n_chains + r), max(20 * d, 200), L)
+        for r in range(rounds):             # pilots start at the centre: the short burn-in is enough
+            pilot = chain(rng_of(n_chains + r), max(20 * d, 200), L, y0.copy(), 50 * d)
             cov = np.cov(pilot.T).reshape(d, d) + 1e-12 * np.eye(d) * np.trace(np.atleast_2d(np.cov(pilot.T)))
             L = np.linalg.cholesky(cov)
-        chains = np.array([chain(rng_of(k), per_chain, L) for k in range(n_chains)])
+        chains = []
+        for k in range(n_chains):
+            rng = rng_of(k)
+            chains.append(chain(rng, per_chain, L, start(rng), burn))
+        chains = np.array(chains)
         x = x0 + chains @ Z.T                                   # (chains, per_chain, 2 kappa)
         rhat = _rhat(x) if n_chains > 1 and per_chain > 1 else np.nan
         return x.reshape(-1, 2 * self.n_contacts) * self.scale, {

@@ -201,5 +201,5 @@ def exact_measures(H, F, mu, width_tol=1e-7, slack_tol=1e-9, feas_tol=1e-10):
         eta_exact=float(np.hypot(width[:, 0], width[:, 1]).sum() / np.hypot(mid[:, 0], mid[:, 1]).sum())
         if finite else np.nan,
         eta_normal=float(width[:, 0].sum() / np.abs(mid[:, 0]).sum()) if finite else np.nan,
-        n_lp=model.n_lp + P.n_lp)
+        n_lp=model.n_lp + P.n_lp, lp_points=np.vstack([points, extra]) * P.scale)
     return out

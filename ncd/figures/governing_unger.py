@@ -12,8 +12,10 @@ samples of the same set ``A ∩ C`` of a slice (:mod:`ncd.scenes.plates`):
   number of samples (:func:`eta_curve`) shows whether it has settled;
 * a uniform sample (:func:`uniform_sample`): hit-and-run in the affine hull of ``A ∩ C``
   (:meth:`ncd.exact.polytope.ForcePolytope.uniform_samples`, implicit equalities found by
-  the exact LPs, directions rounded by pilot chains) from two dispersed starts; the two
-  chains' ``eta_U`` and the Gelman-Rubin R-hat say whether they mixed.
+  the exact LPs, directions shaped by the LPs' vertices and rounded by a pilot chain) from
+  two dispersed starts; the two chains' ``eta_U`` and the Gelman-Rubin R-hat say whether
+  they mixed.  The set sampled is the whole ``A ∩ C`` in the hull of the rank count
+  (``dimension`` = ``dim_AC_rank``): no direction is dropped for being thin.
 
 :func:`centrality` measures their last finding: the history (build) state lies closer to
 the centre of the set than random samples do.
@@ -94,6 +96,7 @@ def uniform_sample(sl, exact, u, rng_of, feas_tol=1e-10):
     equalities); chains that do not agree (:func:`chains_agree`) are drawn again, 4 times
     longer, up to ``u["max_per_chain"]`` points: the cost goes where the set is hard to mix
     (thin, elongated), the same generators make the result independent of the shards.
+    ``u["burn"]`` (default 20): burn-in of each chain, hit-and-run steps per dim^2.
     Returns the pooled samples (2 per_chain, kappa, 2), per-chain means and standard
     deviations (2, kappa, 2), ``eta`` (pooled), ``gap`` (|eta_1 - eta_2| / eta), ``rhat``,
     the dimension and ``per_chain`` (the length used)."""
@@ -108,7 +111,11 @@ def uniform_sample(sl, exact, u, rng_of, feas_tol=1e-10):
 def _two_chains(sl, exact, u, per_chain, rng_of, feas_tol):
     # sampled in r' = (r_n, r_t / mu): the Coulomb sectors become right angles, the thin
     # tangential directions of small mu as wide as the normal ones (a linear map: uniform
-    # in r' is uniform in r), and the implicit rows are the same rows
+    # in r' is uniform in r), and the implicit rows are the same rows.  The range LPs' vertices
+    # shape the first pilot's directions: their spread spans the set's widths (4-5 decades
+    # on thin-sector slices), which pilots from an isotropic start did not find.  A chain
+    # from a far vertex of such a set needs a burn-in ~ dim^2 (like hit-and-run's mixing
+    # time in a rounded body) before its eta_U forgets the start.
     k = len(sl.mu)
     stretch = np.ones((k, 2))
     stretch[:, 1] = np.where(sl.mu > 0, sl.mu, 1.0)
@@ -116,7 +123,9 @@ def _two_chains(sl, exact, u, per_chain, rng_of, feas_tol):
     P = ForcePolytope(H, sl.F, np.where(sl.mu > 0, 1.0, 0.0), feas_tol)
     d = max(int(exact["dim_AC_rank"]), 1)
     x, info = P.uniform_samples(rng_of, 2, per_chain, thin=u.get("thin", 4) * d, rounds=u["rounds"],
-                                implicit=exact["implicit"], dispersed=True)
+                                burn=int(u.get("burn", 20) * d * d),
+                                implicit=exact["implicit"], dispersed=True,
+                                points=(exact["lp_points"].reshape(len(exact["lp_points"]), k, 2) / stretch).reshape(-1, 2 * k))
     x = x.reshape(2, per_chain, k, 2) * stretch
     etas = [eta_u(c) for c in x]
     eta = eta_u(x.reshape(-1, k, 2))
