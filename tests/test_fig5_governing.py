@@ -178,6 +178,12 @@ def test_uniform_sample_of_an_elongated_set_with_implicit_equalities(mu):
         assert gu.eta_u(chain) == pytest.approx(elongated_eta(n, mu), rel=0.1)
 
 
+def test_uniform_samples_reject_points_of_another_space():
+    P = ForcePolytope(sp.csr_matrix([[1.0, 0.0, 1.0, 0.0]]), [-1.0], 0.5)
+    with pytest.raises(ncd.InputError, match="points"):
+        P.uniform_samples(lambda k: np.random.default_rng(k), 2, 10, points=np.zeros((3, 3)))
+
+
 def test_eta_u_is_a_standard_deviation_over_mean_force():
     """Known samples: contact 0 alternates t = ±0.5 at n = 1, contact 1 is fixed at 3."""
     f = np.array([[[1.0, 0.5], [3.0, 0.0]], [[1.0, -0.5], [3.0, 0.0]]] * 2)

@@ -236,6 +236,8 @@ class ForcePolytope:
         thin = None if thin is None else validate.integer("thin", thin, 1, 10 ** 9)
         burn = None if burn is None else validate.integer("burn", burn, 0, 10 ** 9)
         rounds = validate.integer("rounds", rounds, 0, 100)
+        if points is not None:
+            points = validate.array("points", points, (None, 2 * self.n_contacts))
         if not callable(rng_of):
             raise InputError(f"rng_of must be a callable k -> numpy Generator; got {rng_of!r}")
         if not self.is_bounded():
@@ -257,7 +259,7 @@ class ForcePolytope:
         burn = burn or 50 * d
         L = np.eye(d) * res.x[-1]
         if points is not None and len(points) > 1:
-            V = (np.asarray(points, float).reshape(len(points), -1) / self.scale - x0) @ Z
+            V = (points / self.scale - x0) @ Z
             L = np.linalg.cholesky(np.atleast_2d(np.cov(V.T)) + res.x[-1] ** 2 * np.eye(d))
 
         def start(rng):

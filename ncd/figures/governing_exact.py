@@ -169,7 +169,8 @@ def lp_dimension(model, points, basis, tol, max_rounds=200):
 
 def exact_measures(H, F, mu, width_tol=1e-7, slack_tol=1e-9, feas_tol=1e-10):
     """Every exact measure of one packing -> dict (forces in force units); ``feas_tol``:
-    HiGHS's relative feasibility tolerance."""
+    HiGHS's relative feasibility tolerance.  ``lp_points``: the LP points found (rows, forces),
+    vertices whose spread spans the set's widths (the uniform sampler's first rounding)."""
     P = ForcePolytope(H, F, mu, feas_tol)
     k = P.n_contacts
     Hd = P.A_eq.toarray()
