@@ -254,12 +254,16 @@ def test_lp_dimension_agrees_with_rank_count(packings):
 
 
 def test_walk_samples_are_inside_the_exact_ranges(packings):
-    """Every accepted random-walk state lies within the exact range of each force component."""
+    """Every accepted random-walk state lies within the exact range of each force component,
+    up to 1e-5 of the largest walk force.  That margin is conditioning, not sampling: on a
+    nearly determinate slice at mu = 1 of the default run a walk state with an equilibrium
+    residual of 2e-13 and a cone violation of 6e-14 lies 4e-6 (relative) below the LP
+    minimum of one r_n, which a direct LP on the same slice confirms to 1e-9."""
     ok = packings.walk_point.values == 1
     assert ok[:, 0].all() and ok.sum() >= 2 * packings.sizes["packing"]
     for j in range(packings.sizes["packing"]):
         k = int(packings.n_contacts[j])
-        tol = 1e-6 * np.nanmax(np.abs(packings.walk_n.values[j]))
+        tol = 1e-5 * np.nanmax(np.abs(packings.walk_n.values[j]))
         for comp in ("n", "t"):
             lo = np.nan_to_num(packings[f"force_min_{comp}"].values[j, :k], nan=-np.inf)
             hi = np.nan_to_num(packings[f"force_max_{comp}"].values[j, :k], nan=np.inf)
