@@ -28,15 +28,7 @@ from ncd.dynamics.explore import member_rng, shard_members
 from ncd.exact.exact_set import ExactSet
 from ncd.exact.polytope import ForcePolytope
 from ncd.figures.governing_exact import exact_measures
-from ncd.figures.governing_unger import (
-    MIXED_GAP,
-    MIXED_RHAT,
-    centrality,
-    chains_agree,
-    eta_u,
-    random_walk,
-    uniform_sample,
-)
+from ncd.figures.governing_unger import centrality, chains_agree, eta_u, random_walk, uniform_sample
 from ncd.io.netcdf import merge_shards, provenance
 from ncd.scenes import plates
 from ncd.solver.settings import SolverSettings
@@ -444,4 +436,4 @@ def eta_table(ds, var="eta_walk", kind=0):
 
 __all__ = ["KINDS", "mu_values", "build_table", "analysis_table", "ballistic", "initial_cell", "build",
            "pack_shard", "cell_of", "exact_rest", "slice_of", "coordination", "analyse", "plates_bounded", "analysis_shard",
-           "merge", "builds_of", "mixed_only", "eta_table", "SCALARS", "MIXED_GAP", "MIXED_RHAT"]
+           "merge", "builds_of", "mixed_only", "eta_table", "SCALARS"]

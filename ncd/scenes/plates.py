@@ -192,11 +192,9 @@ def slice_problem(cell, contacts, forces, y_lo, y_hi, h, balance=False):
     discs = np.nonzero(inside)[0]
     rows = (3 * discs[:, None] + np.arange(3)).ravel()
     bcols = (2 * touch[:, None] + np.arange(2)).ravel()
-    F = (H[:, bcols] @ forces[touch].ravel())[rows]
     cols = (2 * inner[:, None] + np.arange(2)).ravel()
-    if balance:
-        F = -(H[rows][:, cols] @ forces[inner].ravel())
     Hs = H[rows][:, cols].tocsr()
+    F = -(Hs @ forces[inner].ravel()) if balance else (H[:, bcols] @ forces[touch].ravel())[rows]
     Hs.eliminate_zeros()
     index = np.full(s.n_disc, -1, np.int64)
     index[discs] = np.arange(len(discs))
