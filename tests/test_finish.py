@@ -205,3 +205,28 @@ def test_rest_polyhedron_is_the_equilibrium_set():
     residual = finish.relative_residual(s, (W @ s.ravel() + (Hm.T @ free + problem.bias.ravel())).reshape(-1, 2),
                                         c.mu, 1.0 / W.diagonal()[0::2], mgh)
     assert residual <= 1e-12
+
+
+def test_shared_delassus_is_built_once_and_changes_nothing(column, lp_now):
+    """The global Delassus matrix of a problem is built at its first finished run and kept
+    for every later run on it (ensembles); a run with it is bit-identical to a run that
+    builds its own, with the finishing stage and with local exact solves.  A ``delassus``
+    of the wrong shape is an InputError naming it."""
+    scene, problem = column
+    order = np.random.default_rng(7).permutation(problem.contacts.n)
+    fresh = ncd.prepare_step(scene, H, 1.0, vel=np.zeros_like(scene.vel), spin=np.zeros_like(scene.spin))
+    first = fresh.delassus(scene)
+    assert fresh.delassus(scene) is first
+    for settings in (ncd.SolverSettings(tol=1e-4, finish="active_set", finish_tol=1e-10),
+                     ncd.SolverSettings(tol=1e-9, max_sweeps=3000, check_every=10, local_exact=True)):
+        shared, vel_a, spin_a = ncd.solve_problem(scene, fresh, None, order, settings)
+        vel, spin = fresh.free_vel.copy(), fresh.free_spin.copy()
+        own = ncd.solve_discs(scene, fresh.contacts, vel, spin, None, order, settings, bias=fresh.bias, W=fresh.W)
+        assert fresh.delassus(scene) is first
+        assert np.array_equal(shared.impulse, own.impulse) and np.array_equal(vel_a, vel)
+        assert np.array_equal(spin_a, spin) and shared.sweeps == own.sweeps
+    W, Hm, minv = first
+    vel, spin = fresh.free_vel.copy(), fresh.free_spin.copy()
+    with pytest.raises(ncd.InputError, match="delassus"):
+        ncd.solve_discs(scene, fresh.contacts, vel, spin, settings=ncd.SolverSettings(finish="active_set"),
+                        delassus=(W, Hm[:-3], minv))

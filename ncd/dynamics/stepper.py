@@ -16,6 +16,7 @@ The report of each step carries the largest interpenetration (``-min gap`` at
 ``q_m``), the NLGS sweeps, change, residual and converged flag.  A state that
 goes non-finite or faster than ``speed_limit`` raises :class:`SimulationError`.
 """
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -33,6 +34,7 @@ from ncd.core.errors import InputError, SimulationError
 from ncd.core.jit import njit
 from ncd.core.model import check_scene
 from ncd.core.validate import array, real, shape_of, show
+from ncd.solver.finish import global_delassus
 from ncd.solver.nlgs import restitution_bias, solve_discs
 from ncd.solver.settings import SolverSettings, check_settings_arg
 
@@ -51,6 +53,16 @@ class StepProblem:
     angle_mid: np.ndarray
     vel_initial: np.ndarray
     spin_initial: np.ndarray
+    _delassus: tuple = dataclasses.field(default=None, repr=False, compare=False)
+
+    def delassus(self, scene):
+        """``(W, H, M^-1)`` of :func:`ncd.solver.finish.global_delassus`, built at the first
+        call and kept: the finishing stage and local exact solves of every run of an
+        ensemble on this problem share it (a run of Figure 3 cost three times its sweeps
+        rebuilding it)."""
+        if self._delassus is None or self._delassus[0] is not scene:
+            self._delassus = (scene, global_delassus(scene, self.contacts))
+        return self._delassus[1]
 
     @property
     def max_penetration(self):
@@ -117,11 +129,13 @@ def solve_problem(scene, problem, guess=None, review_order=None, settings=Solver
     is converged only when it has settled too (:mod:`ncd.solver.convergence`).
     ``check=False``: the caller has checked the arguments (as :func:`step` does)."""
     if check:
-        check_step_problem(scene, problem)   # guess, review_order, settings: in solve_discs
+        check_step_problem(scene, problem)   # guess, review_order: in solve_discs
+        check_settings_arg(settings)
     vel = problem.free_vel.copy()
     spin = problem.free_spin.copy()
+    delassus = problem.delassus(scene) if settings.finish != "none" or settings.local_exact else None
     result = solve_discs(scene, problem.contacts, vel, spin, guess, review_order, settings,
-                         bias=problem.bias, W=problem.W, observe=observe, check=check)
+                         bias=problem.bias, W=problem.W, observe=observe, check=check, delassus=delassus)
     return result, vel, spin
 
 

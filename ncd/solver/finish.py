@@ -121,9 +121,11 @@ def project_statuses(W, q, mu, s0, status):
     return (P @ (x0 + min_norm_solve(K, r))).reshape(-1, 2)
 
 
-def polish(lp, W, q, mu, rho, scale, s0, status0, tol, more_sweeps, max_sweeps, sweeps0):
+def polish(make_lp, W, q, mu, rho, scale, s0, status0, tol, more_sweeps, max_sweeps, sweeps0):
     """Finishing stage (module docstring) from the NLGS iterate ``s0`` (``status0``, after
-    ``sweeps0`` sweeps); ``more_sweeps(k) -> (s, status)`` runs NLGS on.  Failed projections
+    ``sweeps0`` sweeps); ``more_sweeps(k) -> (s, status)`` runs NLGS on.  ``make_lp()``
+    builds the :class:`StatusLP`, at the first projection only: most runs of an ensemble
+    reach ``tol`` by NLGS alone, and the LP's matrices cost more than their sweeps.  Failed projections
     are retried after chunks growing 4x, :data:`MAX_ATTEMPTS` times at most.  Returns ``(s,
     status, residual, lp_solves, ok, extra_sweeps, correction)``, the best iterate when the
     budget runs out; ``correction`` is ``|s - s_k|_1 / |s_k|_1`` of the accepted projection
@@ -135,6 +137,7 @@ def polish(lp, W, q, mu, rho, scale, s0, status0, tol, more_sweeps, max_sweeps, 
     res = residual(s)
     best = (res, s, status)
     solves, attempts, extra, chunk, rate = 0, 0, 0, max(FIRST_CHUNK, sweeps0 // 4, 1), None
+    lp = None
     while True:
         if res <= tol:
             return s, status, res, solves, True, extra, 0.0
@@ -149,6 +152,7 @@ def polish(lp, W, q, mu, rho, scale, s0, status0, tol, more_sweeps, max_sweeps, 
         else:
             attempts += 1
             solves += 1
+            lp = make_lp() if lp is None else lp
             cand, _, info = project(lp, s, status)
             if cand is None and res <= REST_GATE:   # no solution with the iterate's statuses: the nearest at rest
                 cand, _, info = project(lp, s, rest_status(lp))
@@ -225,18 +229,22 @@ def polish_local(Wc, q, mu, Wd, data, order, result, settings):
         return flat.reshape(n, 2).copy(), status.copy()
 
     s0 = flat.reshape(n, 2).copy()
-    lp = StatusLP.local(Wc, q, mu, max(float(np.abs(s0).max(initial=0.0)), scale / np.sqrt(n)),
-                        max(float(np.abs(q).max()), 1e-300))
-    out = polish(lp, Wc, q, mu, 1.0 / Wd[:, 0, 0], scale, s0, status.copy(), settings.finish_tol, more,
+
+    def make_lp():
+        return StatusLP.local(Wc, q, mu, max(float(np.abs(s0).max(initial=0.0)), scale / np.sqrt(n)),
+                              max(float(np.abs(q).max()), 1e-300))
+    out = polish(make_lp, Wc, q, mu, 1.0 / Wd[:, 0, 0], scale, s0, status.copy(), settings.finish_tol, more,
                  settings.max_sweeps, result.sweeps)
     flat[:] = out[0].ravel()
     return _finished(result, *out)
 
 
-def polish_discs(scene, contacts, vel, spin, bias, q_free, Wb, flat, order, result, settings):
-    """The finishing stage of :func:`ncd.solver.nlgs.solve_discs`; updates the body velocities."""
+def polish_discs(scene, contacts, vel, spin, bias, q_free, Wb, flat, order, result, settings, delassus=None):
+    """The finishing stage of :func:`ncd.solver.nlgs.solve_discs`; updates the body velocities.
+    ``delassus``: :func:`global_delassus` of the problem, built once by the caller for the
+    many runs of an ensemble (None: built here)."""
     n = contacts.n
-    W, H, minv = global_delassus(scene, contacts)
+    W, H, minv = global_delassus(scene, contacts) if delassus is None else delassus
     scale = problem_scale(q_free, Wb)
     body, imp, status = flat[2].reshape(-1, 4), flat[3], result.status
     s_start = imp.reshape(n, 2).copy()
@@ -249,10 +257,12 @@ def polish_discs(scene, contacts, vel, spin, bias, q_free, Wb, flat, order, resu
     # q of U = W s + q: the free local velocity (bias included) of :func:`ncd.solver.nlgs.solve_discs`
     nm = scene.n_mobile
     free = np.column_stack([vel[:nm], spin[:nm]]).ravel()       # u_free (vel, spin untouched so far)
-    lp = StatusLP.discs(H, minv, free, bias, contacts.mu, scene.radius[:nm],
-                        max(float(np.abs(s_start).max(initial=0.0)), scale / np.sqrt(n)),
-                        max(float(np.abs(q_free).max()), 1e-300))
-    out = polish(lp, W, q_free.ravel(), contacts.mu, 1.0 / Wb[:, 0, 0], scale, s_start, status.copy(),
+
+    def make_lp():
+        return StatusLP.discs(H, minv, free, bias, contacts.mu, scene.radius[:nm],
+                              max(float(np.abs(s_start).max(initial=0.0)), scale / np.sqrt(n)),
+                              max(float(np.abs(q_free).max()), 1e-300))
+    out = polish(make_lp, W, q_free.ravel(), contacts.mu, 1.0 / Wb[:, 0, 0], scale, s_start, status.copy(),
                  settings.finish_tol, more, settings.max_sweeps, result.sweeps)
     s = out[0]
     if not np.array_equal(s, imp.reshape(n, 2)):       # a projection: u_f = u_free + M^-1 H s

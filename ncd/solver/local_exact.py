@@ -61,8 +61,9 @@ def region(moved, body_a, body_b, n_mobile):
 class LocalExact:
     """The stall test and the local exact solves of one disc-form run."""
 
-    def __init__(self, scene, contacts, free, q_free, flat, reset=None):
-        self.W, self.H, self.minv = global_delassus(scene, contacts)
+    def __init__(self, scene, contacts, free, q_free, flat, reset=None, delassus=None):
+        # delassus: global_delassus of the problem, when the caller built it once for many runs
+        self.W, self.H, self.minv = global_delassus(scene, contacts) if delassus is None else delassus
         self.W = self.W.tocsr()
         self.q = np.asarray(q_free, float).ravel()
         self.mu = contacts.mu

@@ -55,7 +55,7 @@ def _restitution_bias(e_n, e_t, U_initial):
 
 @validate.finite_output
 def solve_discs(scene, contacts, vel, spin, guess=None, review_order=None,
-                settings=SolverSettings(), bias=None, W=None, observe=None, check=True):
+                settings=SolverSettings(), bias=None, W=None, observe=None, check=True, delassus=None):
     """Solve the core problem of one step by NLGS in disc form.
 
     ``vel, spin`` hold the free velocities on entry and the end-of-step
@@ -64,10 +64,14 @@ def solve_discs(scene, contacts, vel, spin, guess=None, review_order=None,
     contacts (identity if None); ``bias`` the restitution term ``e U_i``;
     ``observe(impulse, vel, spin)``: see :func:`ncd.solver.convergence.run_nlgs`.
     ``check=False``: the caller has checked the arguments (:func:`ncd.step` does).
+    ``delassus``: ``(W, H, M^-1)`` of :func:`ncd.solver.finish.global_delassus` for these
+    contacts, which the finishing stage and local exact solves need; an ensemble of runs
+    on one problem builds it once (None: built here when needed).
     """
     if check:
         guess, review_order, bias, W = check_disc_problem(scene, contacts, vel, spin, guess, review_order,
                                                            settings, bias, W)
+        check_delassus(delassus, contacts.n, scene.n_mobile)
     if observe is not None and not callable(observe):
         raise InputError(f"observe = {observe!r} must be None or a callable (impulse, vel, spin) -> array")
     n = contacts.n
@@ -92,13 +96,14 @@ def solve_discs(scene, contacts, vel, spin, guess=None, review_order=None,
     if settings.local_exact:
         nm = scene.n_mobile
         local = LocalExact(scene, contacts, np.column_stack([vel[:nm], spin[:nm]]).ravel(), q_free, flat,
-                           getattr(iterate, "reset", None))
+                           getattr(iterate, "reset", None), delassus)
         iterate = local.driver(iterate)
     result = run_nlgs(iterate, flat, order, status, problem_scale(q_free, W), settings, look)
     result.impulse = impulse
     result.local_solves = 0 if local is None else local.solves
     if settings.finish != "none":
-        result = polish_discs(scene, contacts, vel, spin, bias, q_free, W, flat, order, result, settings)
+        result = polish_discs(scene, contacts, vel, spin, bias, q_free, W, flat, order, result, settings,
+                              delassus)
     vel[:] = body[:-1, :2]
     spin[:] = body[:-1, 2]
     return result
@@ -166,6 +171,18 @@ def check_local_problem(W, q, mu, guess, review_order, settings):
                              f"= {[[float(nn[k]), float(nt[k])], [float(tn[k]), float(tt[k])]]} is not")
     check_settings_arg(settings)
     return Wc, q, mu, impulse_guess("guess", guess, n), permutation("review_order", review_order, n)
+
+
+def check_delassus(delassus, n, n_mobile):
+    """``delassus`` of :func:`solve_discs`: None, or ``(W, H, minv)`` with ``W`` sparse
+    (2n, 2n), ``H`` sparse (3 n_mobile, 2n) and ``minv`` (3 n_mobile,)."""
+    if delassus is None:
+        return
+    shapes = ((2 * n, 2 * n), (3 * n_mobile, 2 * n), (3 * n_mobile,))
+    if not (isinstance(delassus, tuple) and len(delassus) == 3 and sp.issparse(delassus[0])
+            and sp.issparse(delassus[1]) and all(x.shape == sh for x, sh in zip(delassus, shapes))):
+        raise InputError(f"delassus must be None or (W, H, minv) of global_delassus with shapes {shapes}; "
+                         f"got {show(delassus)}")
 
 
 def check_disc_problem(s, c, vel, spin, guess, review_order, settings, bias, W):
