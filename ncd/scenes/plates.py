@@ -71,15 +71,16 @@ def make_cell(disc_scene, plate_y, plate_mass, force):
     return Cell(check_scene(scene, "cell"), float(force))
 
 
-def cell_contacts(cell, pos, alert):
+def cell_contacts(cell, pos, alert, check=True):
     """Contacts of the cell at positions ``pos``: the disc grid's (discs, bottom wall) and the
-    top plate's (frictionless, body ``n``), sorted by the cell's pair keys."""
+    top plate's (frictionless, body ``n``), sorted by the cell's pair keys.  ``check=False``:
+    the caller has checked the cell (:func:`step` does at its first call of a build)."""
     s, n = cell.scene, cell.n
     discs = Scene(**{**s.__dict__, "pos": pos[:n], "radius": s.radius[:n], "inv_mass": s.inv_mass[:n],
                      "inv_inertia": s.inv_inertia[:n], "mass": s.mass[:n], "n_mobile": n,
                      "angle": s.angle[:n], "vel": s.vel[:n], "spin": s.spin[:n],
                      "prev_keys": None, "prev_impulse": None})
-    c = detect_contacts(discs, alert=alert, pos=pos[:n])
+    c = detect_contacts(discs, alert=alert, pos=pos[:n], check=check)
     gap = pos[n, 1] - pos[:n, 1] - s.radius[:n]
     top = np.nonzero(gap <= alert)[0].astype(np.int64)
     k = len(top)
@@ -97,14 +98,14 @@ def cell_contacts(cell, pos, alert):
     return Contacts(**{f: v[order] for f, v in fields.items()})
 
 
-def prepare(cell, h, theta=0.5, vel=None, spin=None):
+def prepare(cell, h, theta=0.5, vel=None, spin=None, check=True):
     """The core problem of one Moreau-Jean step of the cell (the plate pushed by ``force``)."""
     s, n = cell.scene, cell.n
     vel = s.vel if vel is None else vel
     spin = s.spin if spin is None else spin
     pos_mid = s.pos + (1.0 - theta) * h * vel
     angle_mid = s.angle + (1.0 - theta) * h * spin
-    c = cell_contacts(cell, pos_mid, 1e-9 * s.radius.min())
+    c = cell_contacts(cell, pos_mid, 1e-9 * s.radius.min(), check)
     W = delassus_blocks(c.body_a, c.body_b, c.arm_a, c.arm_b, s.inv_mass, s.inv_inertia)
     U_i = local_velocity(c.body_a, c.body_b, c.normal, c.arm_a, c.arm_b, vel, spin, np.empty((c.n, 2)))
     free_vel = vel.copy()
@@ -113,12 +114,16 @@ def prepare(cell, h, theta=0.5, vel=None, spin=None):
                        vel.copy(), spin.copy())
 
 
-def step(cell, h, settings, theta=0.5):
-    """One Moreau-Jean step of the cell in place (warm start by pair key); the NLGS result."""
+def step(cell, h, settings, theta=0.5, check=True):
+    """One Moreau-Jean step of the cell in place (warm start by pair key); the NLGS result.
+
+    ``check=False``: the cell and settings were checked at an earlier step of the same
+    build (the checks of every step cost more than its sweeps on a 60-disc cell); the
+    solver still refuses a non-finite result."""
     s = cell.scene
-    p = prepare(cell, h, theta)
+    p = prepare(cell, h, theta, check=check)
     guess = _warm(p.contacts, s.prev_keys, s.prev_impulse)
-    res, vel, spin = solve_problem(s, p, guess, None, settings)
+    res, vel, spin = solve_problem(s, p, guess, None, settings, check=check)
     vel[cell.n, 0] = 0.0
     pos = p.pos_mid + theta * h * vel
     pos[:, 0] %= s.period
@@ -137,14 +142,15 @@ def _warm(c, keys, impulse):
     return np.where(hit[:, None], impulse[j], 0.0)
 
 
-def rest_state(cell, h, settings, guess=None):
+def rest_state(cell, h, settings, guess=None, check=True):
     """The one-step problem from rest (the equilibrium test): ``(forces, max |u_f|, problem,
-    result)``, forces ``r = s / h`` of every contact, ``|u_f|`` over discs and plate."""
+    result)``, forces ``r = s / h`` of every contact, ``|u_f|`` over discs and plate.
+    ``check``: as in :func:`step`."""
     s = cell.scene
-    p = prepare(cell, h, 1.0, vel=np.zeros_like(s.vel), spin=np.zeros_like(s.spin))
+    p = prepare(cell, h, 1.0, vel=np.zeros_like(s.vel), spin=np.zeros_like(s.spin), check=check)
     if guess is None:
         guess = _warm(p.contacts, s.prev_keys, s.prev_impulse)
-    res, vel, spin = solve_problem(s, p, guess, None, settings)
+    res, vel, spin = solve_problem(s, p, guess, None, settings, check=check)
     umax = max(np.abs(vel).max(), np.abs(spin * s.radius).max())
     return res.impulse / h, float(umax), p, res
 
