@@ -53,7 +53,7 @@ class StepProblem:
     angle_mid: np.ndarray
     vel_initial: np.ndarray
     spin_initial: np.ndarray
-    _delassus: tuple = dataclasses.field(default=None, repr=False, compare=False)
+    _delassus: tuple = dataclasses.field(default=None, init=False, repr=False, compare=False)
 
     def delassus(self, scene):
         """``(W, H, M^-1)`` of :func:`ncd.solver.finish.global_delassus`, built at the first
