@@ -7,7 +7,7 @@ its statuses. Shared by the census of Figure 2 and the slope flows of Figure 5.
 
 import numpy as np
 
-from ncd.solver.finish import global_delassus, natural_map, project_statuses, relative_residual
+from ncd.solver.finish import natural_map, project_statuses, relative_residual
 from ncd.solver.single_contact import SLIDE_BACKWARD, STICK
 
 
@@ -17,7 +17,7 @@ class StepSolutions:
     def __init__(self, scene, problem):
         c = problem.contacts
         self.scene, self.problem, self.h, self.nm = scene, problem, problem.h, scene.n_mobile
-        self.W, self.H, self.minv = global_delassus(scene, c)
+        self.W, self.H, self.minv = problem.delassus(scene)     # shared with the problem's NLGS runs
         nm = self.nm
         self.free = np.column_stack([problem.free_vel[:nm], problem.free_spin[:nm]]).ravel()
         self.q = (self.H.T @ self.free).reshape(-1, 2) + problem.bias
