@@ -230,3 +230,7 @@ def test_shared_delassus_is_built_once_and_changes_nothing(column, lp_now):
     with pytest.raises(ncd.InputError, match="delassus"):
         ncd.solve_discs(scene, fresh.contacts, vel, spin, settings=ncd.SolverSettings(finish="active_set"),
                         delassus=(W, Hm[:-3], minv))
+    for bad in ((W, Hm, list(minv)[:-1]), (W, Hm, np.where(np.arange(len(minv)) == 0, np.nan, minv))):
+        with pytest.raises(ncd.InputError, match="delassus"):
+            ncd.solve_discs(scene, fresh.contacts, vel, spin, settings=ncd.SolverSettings(local_exact=True),
+                            delassus=bad)

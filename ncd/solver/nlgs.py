@@ -175,14 +175,18 @@ def check_local_problem(W, q, mu, guess, review_order, settings):
 
 def check_delassus(delassus, n, n_mobile):
     """``delassus`` of :func:`solve_discs`: None, or ``(W, H, minv)`` with ``W`` sparse
-    (2n, 2n), ``H`` sparse (3 n_mobile, 2n) and ``minv`` (3 n_mobile,)."""
+    (2n, 2n), ``H`` sparse (3 n_mobile, 2n) and ``minv`` (3 n_mobile,), all finite (a NaN
+    would reach the Lemke kernel of the local exact solves)."""
     if delassus is None:
         return
     shapes = ((2 * n, 2 * n), (3 * n_mobile, 2 * n), (3 * n_mobile,))
     if not (isinstance(delassus, tuple) and len(delassus) == 3 and sp.issparse(delassus[0])
-            and sp.issparse(delassus[1]) and all(x.shape == sh for x, sh in zip(delassus, shapes))):
+            and sp.issparse(delassus[1]) and all(np.shape(x) == sh for x, sh in zip(delassus, shapes))):
         raise InputError(f"delassus must be None or (W, H, minv) of global_delassus with shapes {shapes}; "
                          f"got {show(delassus)}")
+    W, H, minv = delassus
+    if not (np.isfinite(W.data).all() and np.isfinite(H.data).all() and np.isfinite(minv).all()):
+        raise InputError("delassus (W, H, minv) must be finite; it holds NaN or inf")
 
 
 def check_disc_problem(s, c, vel, spin, guess, review_order, settings, bias, W):
