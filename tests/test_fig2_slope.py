@@ -426,6 +426,21 @@ def test_census_solutions_are_exact_and_contain_the_nlgs_end_points(data, result
             assert d > ccfg["same_tol"] * step.g
 
 
+def test_census_random_runs_by_local_exact_solves_end_where_plain_nlgs_ends(results):
+    """The census's random-guess runs make local exact solves where NLGS stalls; the members
+    rerun by plain NLGS (same guesses, same orders) all end on the same census solution, their
+    accelerations within basin_tol |g| of the local route's, and the page says so."""
+    cen = xr.load_dataset(results / "fig2_slope" / "census.nc")
+    ccfg = yaml.safe_load(cen.attrs["config_yaml"])
+    a = cen.attrs
+    assert ccfg["random_local_exact"] and int(a["random_plain_runs"]) == min(ccfg["random_plain_check"],
+                                                                          ccfg["random_runs"]) > 0
+    assert int(a["random_plain_same"]) == int(a["random_plain_runs"])
+    assert 0 <= float(a["random_plain_distance"]) <= ccfg["basin_tol"]
+    assert f"{int(a['random_plain_same'])} of {int(a['random_plain_runs'])} of them rerun by plain NLGS" \
+        in census.census_text(cen)
+
+
 def test_angles_say_what_they_hold(data):
     """``trajectory.angle`` is the discs' rotation in radians (it was labelled degrees): at the
     investigated step it differs from the stored frame of that step by at most one step of spin.

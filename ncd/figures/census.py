@@ -9,6 +9,7 @@ covering vectors, and an enumeration of status patterns of the switching contact
 solution: its basin (which runs end on it) and its stability under perturbation.
 """
 import time
+from dataclasses import replace
 
 import numpy as np
 import xarray as xr
@@ -101,6 +102,40 @@ def nlgs_end_points(ens, measures):
     return [imp[int(np.nonzero(labels == k)[0][0])] for k in range(int(labels.max()) + 1)]
 
 
+def random_runs(scene, problem, s_scale, cc):
+    """The census's NLGS runs from random guesses, to ``random_tol``, and the plain-NLGS check.
+
+    With ``random_local_exact`` the runs make local exact solves where the residual stalls
+    (:mod:`ncd.solver.local_exact`): plain NLGS needs several times the sweeps to 1e-8 from a
+    random guess, and the census asks only which solution a run ends on.  The first
+    ``random_plain_check`` members are also run by plain NLGS (same guesses and review
+    orders), the check that both routes end on the same solution (:func:`_plain_check`).
+    Returns ``(runs, plain)``, ``plain`` None when there is no check."""
+    members = np.arange(cc["random_runs"])
+    local = bool(cc["random_local_exact"])
+    settings = SolverSettings(tol=cc["random_tol"], max_sweeps=cc["max_sweeps"], check_every=10, local_exact=local)
+    rnd = explore(scene, problem, members, cc["root_seed"], init="random", guess_scale=s_scale, settings=settings)
+    n_check = min(int(cc["random_plain_check"]), len(members)) if local else 0
+    if n_check == 0:
+        return rnd, None
+    plain = explore(scene, problem, members[:n_check], cc["root_seed"], init="random", guess_scale=s_scale,
+                    settings=replace(settings, local_exact=False))
+    return rnd, plain
+
+
+def _plain_check(step, census, plain, acc_rnd, label_rnd, basin_tol):
+    """Plain NLGS against local exact solves on the checked members: how many end on the
+    same census solution (both converged), and the largest acceleration distance (/ |g|)."""
+    if plain is None:
+        return {"runs": 0, "same": 0, "distance": np.nan}
+    k = len(plain["impulse"])
+    acc = np.array([step.accel(s) for s in plain["impulse"]])
+    label = census.nearest(acc, basin_tol)
+    label[~plain["converged"]] = -2
+    same = (label == label_rnd[:k]) & (label >= 0)
+    return {"runs": k, "same": int(same.sum()), "distance": float(np.abs(acc - acc_rnd[:k]).max() / step.g)}
+
+
 def run_census(traj, ens, measures, cfg, log=None):
     """The census of the investigated step: a dict of arrays and counts (see :func:`census_dataset`)."""
     cc = cfg["census"]
@@ -118,9 +153,7 @@ def run_census(traj, ens, measures, cfg, log=None):
             per_method["nlgs"].add(k)
     # random-guess NLGS runs
     s_scale = float(np.abs(np.array(census.impulse)[..., 0]).max()) if census.impulse else 1.0
-    settings = SolverSettings(tol=cc["random_tol"], max_sweeps=cc["max_sweeps"], check_every=10)
-    rnd = explore(scene, problem, np.arange(cc["random_runs"]), cc["root_seed"], init="random",
-                  guess_scale=s_scale, settings=settings)
+    rnd, plain_check = random_runs(scene, problem, s_scale, cc)
     for s in rnd["impulse"][rnd["converged"]]:
         k = census.add(s, "nlgs", ptol)
         if k >= 0:
@@ -162,6 +195,7 @@ def run_census(traj, ens, measures, cfg, log=None):
     acc_rnd = np.array([step.accel(s) for s in rnd["impulse"]])
     label_rnd = census.nearest(acc_rnd, basin_tol)
     label_rnd[~rnd["converged"]] = -2
+    check = _plain_check(step, census, plain_check, acc_rnd, label_rnd, basin_tol)
     # stability under perturbation
     n_sol = len(census.accel)
     returns = np.zeros(n_sol, np.int64)
@@ -191,7 +225,7 @@ def run_census(traj, ens, measures, cfg, log=None):
             "label_rnd": label_rnd, "returns": returns, "segment_t": seg_t, "segment_residual": seg,
             "segment_pair": pair, "switching": switching_contacts([step.status(s) for s in census.impulse]),
             "switching_before": switching, "n_patterns": n_patterns, "n_clusters": n_clusters,
-            "lemke_info": lemke_info,
+            "lemke_info": lemke_info, "plain_check": check,
             "checks": checks, "times": times, "random_scale": s_scale,
             "statuses": np.array([step.status(s) for s in census.impulse])}
 
@@ -249,6 +283,8 @@ def census_dataset(traj, ens, measures, cfg, log=None):
                          n_switching_before=len(out["switching_before"]), segment_pair=out["segment_pair"].astype(np.int64),
                          random_guess_scale=out["random_scale"],
                          random_converged=int((out["label_rnd"] != -2).sum()),
+                         random_plain_runs=out["plain_check"]["runs"], random_plain_same=out["plain_check"]["same"],
+                         random_plain_distance=out["plain_check"]["distance"],
                          lemke_status="; ".join(f"{i['status']} after {i['pivots']} pivots" for i in out["lemke_info"])),
     )
     for k, (u, ln) in {"solution": ("1", "exact solution index"), "disc": ("1", "grain index"),
@@ -285,6 +321,15 @@ def cloud_text(c, grain, tol, line_ratio):
                    "by the iteration error.")
 
 
+def _plain_text(a):
+    """The random runs' route and its plain-NLGS check, for :func:`census_text`."""
+    runs = int(a.get("random_plain_runs", 0))
+    if runs == 0:
+        return ""
+    return (f", with local exact solves where NLGS stalls; {int(a['random_plain_same'])} of {runs} of them rerun by "
+            f"plain NLGS end on the same solution, accelerations at most {float(a['random_plain_distance']):.0e} |g| apart")
+
+
 def census_text(ds):
     """Markdown from census.nc: how many exact solutions each method found, and a table
     of the solutions (how found, basins, stability, the chosen grain's acceleration)."""
@@ -294,7 +339,7 @@ def census_text(ds):
     head = (f"The census finds **{n} distinct exact solutions** of the step (relative natural-map residual "
             f"at most {float(ds.residual.max()):.0e}, largest componentwise violation of the contact law "
             f"{float(ds.law_violation.max()):.0e}): {a['n_nlgs']} among the NLGS end points (zero-guess, "
-            f"warm-start and {a['random_converged']} converged random-guess runs), {a['n_lemke']} by Lemke's "
+            f"warm-start and {a['random_converged']} converged random-guess runs{_plain_text(a)}), {a['n_lemke']} by Lemke's "
             f"method ({a['lemke_status']}), {a['n_enumeration']} by the enumeration of "
             f"{a['n_patterns']} status patterns (per round: "
             f"{', '.join(str(int(v)) for v in np.atleast_1d(a['patterns_per_round']))}; the switching contacts, "
