@@ -17,7 +17,7 @@ SCHEMAS = ROOT / "workflow" / "schemas"
 CONFIG = yaml.safe_load((ROOT / "config.yaml").read_text())
 FIGURES = [f for f in ("fig1_wedged", "fig2_slope", "fig3_equilibrium", "fig4_pile") if f in CONFIG]
 # rules a figure target shares with the others: the HTML rendering and the reproduction page
-SHARED = {"render_html", "html_mathjax", "index", "all"}
+SHARED = {"render_html", "html_mathjax", "index", "all", "code_stamp"}
 
 
 def planned_jobs(proc):
@@ -243,6 +243,20 @@ def test_editing_a_figure_module_reruns_that_figure_only(dag_repo, figure):
     if figure == ALL_FIGURES[0]:
         core = plan_after_editing(dag_repo, "solver/nlgs.py")
         assert {f"{f}_notebook" for f in ALL_FIGURES} <= set(core), core
+
+
+def test_a_code_stamp_holds_the_hash_of_each_source_of_its_set(dag_repo):
+    """A computing rule lists one stamp for its sources (results/code/<name>.sha256): the
+    SHA-256 of every file of the set, by path in the checkout; the lower layers and the
+    figure's own modules are in it, its page modules and ncd/pages are not."""
+    import hashlib
+    lines = (dag_repo / "results" / "code" / "fig1_wedged.sha256").read_text().splitlines()
+    stamp = dict(reversed(line.split("  ", 1)) for line in lines)
+    assert len(stamp) == len(lines) > 20
+    assert {"ncd/solver/nlgs.py", "ncd/core/contacts.py", "ncd/figures/wedged.py"} <= set(stamp)
+    assert not [p for p in stamp if p.startswith("ncd/pages/") or p.endswith("_page.py")]
+    for path, digest in stamp.items():
+        assert hashlib.sha256((dag_repo / path).read_bytes()).hexdigest() == digest, path
 
 
 @pytest.mark.parametrize("module, rules", [

@@ -20,7 +20,7 @@ BENCH_THREADS = 2
 
 rule bench_core:
     input:
-        ncd_sources(FIGB),
+        figure_code(FIGB),
     output:
         "results/bench/core.nc",
     threads: BENCH_THREADS
@@ -38,7 +38,7 @@ rule bench_core:
 
 rule bench_sweeps:
     input:
-        ncd_sources(FIGB),
+        figure_code(FIGB),
     output:
         "results/bench/sweeps.nc",
     threads: BENCH_THREADS
@@ -56,7 +56,7 @@ rule bench_sweeps:
 
 rule bench_tolerance:
     input:
-        ncd_sources(FIGB),
+        figure_code(FIGB),
         construction="results/fig4_pile/construction.nc",
         trajectory="results/fig2_slope/trajectory.nc",
     output:
@@ -79,7 +79,7 @@ rule bench_tolerance:
 
 rule bench_ensemble:
     input:
-        ncd_sources(FIGB),
+        figure_code(FIGB),
     output:
         "results/bench/ensemble.nc",
     threads: BENCH_THREADS
@@ -97,7 +97,7 @@ rule bench_ensemble:
 
 rule bench_peer:
     input:
-        ncd_sources(FIGB),
+        figure_code(FIGB),
     output:
         "results/bench/peer.nc",
     threads: BENCH_THREADS

@@ -7,7 +7,7 @@ CFG = section(FIG)
 rule error_vs_runtime_nlgs:
     """Build each state and run every NLGS setting on its next step."""
     input:
-        ncd_sources(FIG),
+        figure_code(FIG),
     output:
         "results/error_vs_runtime/nlgs.nc",
     params:
@@ -25,7 +25,7 @@ rule error_vs_runtime_nlgs:
 rule error_vs_runtime_integration:
     """CD over h and MD over h and stiffness, for each observable."""
     input:
-        ncd_sources(FIG),
+        figure_code(FIG),
     output:
         "results/error_vs_runtime/integration.nc",
     params:

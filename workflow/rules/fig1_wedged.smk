@@ -6,7 +6,7 @@ CFG = section(FIG)
 rule fig1_wedged_explore:
     """One shard of the one-step exploration ensemble (random and zero initial guesses)."""
     input:
-        ncd_sources(FIG),
+        figure_code(FIG),
     output:
         temp("results/fig1_wedged/shards/{name}_{shard}-of-{n}.nc"),
     wildcard_constraints:
@@ -46,7 +46,7 @@ rule fig1_wedged_merge:
 rule fig1_wedged_simulate:
     """The two evolutions (zero guess at every step; wedged first guess then warm starts)."""
     input:
-        ncd_sources(FIG),
+        figure_code(FIG),
     output:
         "results/fig1_wedged/evolutions.nc",
     params:
@@ -65,7 +65,7 @@ rule fig1_wedged_simulate:
 rule fig1_wedged_sweep:
     """Fraction of wedged outcomes against the friction angle."""
     input:
-        ncd_sources(FIG),
+        figure_code(FIG),
     output:
         "results/fig1_wedged/sweep.nc",
     params:

@@ -20,7 +20,7 @@ CFG2_EXP = {k: CFG2[k] for k in ("scene", "flow", "explore")}
 rule fig2_slope_simulate:
     priority: PRIORITY["fig2_slope"]
     input:
-        ncd_sources(FIG2),
+        figure_code(FIG2),
     output:
         f"{F2}/trajectory.nc",
     params:
@@ -38,7 +38,7 @@ rule fig2_slope_simulate:
 rule fig2_slope_explore:
     priority: PRIORITY["fig2_slope"]
     input:
-        ncd_sources(FIG2),
+        figure_code(FIG2),
         trajectory=f"{F2}/trajectory.nc",
     output:
         temp(f"{F2}/shards/ensemble_{{shard}}-of-{{n}}.nc"),
@@ -79,7 +79,7 @@ rule fig2_slope_merge:
 rule fig2_slope_analyse:
     priority: PRIORITY["fig2_slope"]
     input:
-        ncd_sources(FIG2),
+        figure_code(FIG2),
         trajectory=f"{F2}/trajectory.nc",
         ensemble=f"{F2}/ensemble.nc",
     output:
@@ -99,7 +99,7 @@ rule fig2_slope_analyse:
 rule fig2_slope_census:
     priority: PRIORITY["fig2_slope"]
     input:
-        ncd_sources(FIG2),
+        figure_code(FIG2),
         trajectory=f"{F2}/trajectory.nc",
         ensemble=f"{F2}/ensemble.nc",
         measures=f"{F2}/measures.nc",

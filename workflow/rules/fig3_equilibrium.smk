@@ -18,7 +18,7 @@ F3_SOURCES = [f for f in ncd_sources(FIG) if f not in F3_PAGE]
 
 rule fig3_equilibrium_simulate:
     input:
-        F3_SOURCES,
+        code(FIG, F3_SOURCES),
     output:
         f"{F3}/state.nc",
     params:
@@ -35,7 +35,7 @@ rule fig3_equilibrium_simulate:
 
 rule fig3_equilibrium_explore:
     input:
-        F3_SOURCES,
+        code(FIG, F3_SOURCES),
         state=f"{F3}/state.nc",
     output:
         temp(f"{F3}/shards/{{name}}_{{shard}}-of-{{n}}.nc"),
@@ -75,7 +75,7 @@ rule fig3_equilibrium_merge:
 
 rule fig3_equilibrium_projection:
     input:
-        F3_SOURCES,
+        code(FIG, F3_SOURCES),
         state=f"{F3}/state.nc",
     output:
         f"{F3}/projection.nc",
@@ -93,7 +93,7 @@ rule fig3_equilibrium_projection:
 
 rule fig3_equilibrium_uniform:
     input:
-        F3_SOURCES,
+        code(FIG, F3_SOURCES),
         state=f"{F3}/state.nc",
     output:
         f"{F3}/uniform.nc",

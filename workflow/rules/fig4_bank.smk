@@ -34,7 +34,7 @@ BANK_EXACT_CFG = {k: v for k, v in BANK_CFG.items() if k not in ("analysis", "ve
 
 rule fig4_bank_measure:
     input:
-        BANK_SOURCES,
+        code(BANK_FIG, BANK_SOURCES),
         construction="results/fig4_pile/construction.nc",
         cuts="results/fig4_pile/cuts.nc",
         piles=BANK_PILES,
@@ -54,7 +54,7 @@ rule fig4_bank_measure:
 
 rule fig4_bank_exact:
     input:
-        BANK_SOURCES,
+        code(BANK_FIG, BANK_SOURCES),
         pile=lambda w: bank_pile(w.pile),
         cuts=lambda w: "results/fig4_pile/cuts.nc" if w.pile == "default" else [],   # the default pile's fits
     output:

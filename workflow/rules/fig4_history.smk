@@ -77,7 +77,7 @@ FH_EXACT_SOURCES = [f for f in ncd_sources(FIGH) if not f.endswith(("history_plo
 
 rule fig4_history_construct:
     input:
-        FH_BUILD_SOURCES,
+        code(f"{FIGH}_build", FH_BUILD_SOURCES),
         point=lambda w: [] if w.history == "point" else f"{FH}/piles/n{w.n}/point_{w.member}.nc",
     output:
         f"{FH}/piles/n{{n}}/{{history}}_{{member}}.nc",
@@ -100,7 +100,7 @@ rule fig4_history_construct:
 
 rule fig4_history_exact:
     input:
-        FH_EXACT_SOURCES,
+        code(f"{FIGH}_exact", FH_EXACT_SOURCES),
         pile=f"{FH}/piles/n{{n}}/{{history}}_{{member}}.nc",
     output:
         f"{FH}/exact/n{{n}}/{{history}}_{{member}}.nc",
@@ -122,7 +122,7 @@ rule fig4_history_exact:
 
 rule fig4_history_analyse:
     input:
-        ncd_sources(FIGH),
+        figure_code(FIGH),
         piles=lambda w: piles_of(w.n),
         exact=lambda w: exact_of(w.n),
     output:
@@ -177,7 +177,7 @@ FHS = "fig4_history_size"
 rule fig4_history_size_analyse:
     """The analyses of every pile size side by side (ncd.figures.history_size)."""
     input:
-        ncd_sources(FIGH),
+        figure_code(FIGH),
         analyses=[f"{FH}/analysis_n{n}.nc" for n in SIZES],
     output:
         f"{FH}/size.nc",

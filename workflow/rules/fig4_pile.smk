@@ -27,7 +27,7 @@ F4_SOURCES = [f for f in ncd_sources(FIG4) if f != F4_PLOTS]
 rule fig4_pile_simulate:
     priority: PRIORITY["fig4_pile"]
     input:
-        F4_SOURCES,
+        code(FIG4, F4_SOURCES),
     output:
         f"{F4}/construction.nc",
     params:
@@ -45,7 +45,7 @@ rule fig4_pile_simulate:
 rule fig4_pile_cuts:
     priority: PRIORITY["fig4_pile"]
     input:
-        F4_SOURCES,
+        code(FIG4, F4_SOURCES),
         construction=f"{F4}/construction.nc",
     output:
         f"{F4}/cuts.nc",
@@ -64,7 +64,7 @@ rule fig4_pile_cuts:
 rule fig4_pile_exact:
     priority: PRIORITY["fig4_pile"]
     input:
-        F4_SOURCES,
+        code(FIG4, F4_SOURCES),
         construction=f"{F4}/construction.nc",
         cuts=f"{F4}/cuts.nc",
     output:
@@ -84,7 +84,7 @@ rule fig4_pile_exact:
 rule fig4_pile_explore:
     priority: PRIORITY["fig4_pile"]
     input:
-        F4_SOURCES,
+        code(FIG4, F4_SOURCES),
         construction=f"{F4}/construction.nc",
         cuts=f"{F4}/cuts.nc",
     output:

@@ -13,7 +13,7 @@ F5 = f"results/{FIG}"
 
 rule fig5_governing_pack:
     input:
-        ncd_sources(FIG),
+        figure_code(FIG),
     output:
         temp(f"{F5}/shards/packs_{{shard}}-of-{{n}}.nc"),
     wildcard_constraints:
@@ -33,7 +33,7 @@ rule fig5_governing_pack:
 
 rule fig5_governing_analyse:
     input:
-        ncd_sources(FIG),
+        figure_code(FIG),
         packs=shard_files(FIG, "packs", CFG["shards"]),
     output:
         temp(f"{F5}/shards/analyses_{{shard}}-of-{{n}}.nc"),
@@ -117,7 +117,7 @@ FLOW_SHARDS = [f"{F5}/shards/flow_{i}_seed{s}.nc" for i in range(len(FLOW_MU)) f
 
 rule fig5_governing_deposit:
     input:
-        ncd_sources(FIG),
+        figure_code(FIG),
     output:
         temp(f"{F5}/shards/deposit_seed{{s}}.nc"),
     wildcard_constraints:
@@ -136,7 +136,7 @@ rule fig5_governing_deposit:
 
 rule fig5_governing_flow:
     input:
-        ncd_sources(FIG),
+        figure_code(FIG),
         deposit=f"{F5}/shards/deposit_seed{{s}}.nc",
     output:
         temp(f"{F5}/shards/flow_{{i}}_seed{{s}}.nc"),

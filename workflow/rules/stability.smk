@@ -7,7 +7,7 @@ CFG = section(FIG)
 rule stability_simulate:
     """The stability table: one row per (case, method, h)."""
     input:
-        ncd_sources(FIG),
+        figure_code(FIG),
     output:
         "results/stability/table.nc",
     params:
