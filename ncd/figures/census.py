@@ -123,15 +123,22 @@ def random_runs(scene, problem, s_scale, cc):
     return rnd, plain
 
 
+def end_labels(step, census, runs, basin_tol):
+    """Accelerations of the end points of :func:`ncd.dynamics.explore.explore` ``runs`` and
+    the census solution each ends on (-1: none within ``basin_tol``, -2: not converged)."""
+    acc = np.array([step.accel(s) for s in runs["impulse"]])
+    label = census.nearest(acc, basin_tol)
+    label[~runs["converged"]] = -2
+    return acc, label
+
+
 def _plain_check(step, census, plain, acc_rnd, label_rnd, basin_tol):
     """Plain NLGS against local exact solves on the checked members: how many end on the
     same census solution (both converged), and the largest acceleration distance (/ |g|)."""
     if plain is None:
         return {"runs": 0, "same": 0, "distance": np.nan}
     k = len(plain["impulse"])
-    acc = np.array([step.accel(s) for s in plain["impulse"]])
-    label = census.nearest(acc, basin_tol)
-    label[~plain["converged"]] = -2
+    acc, label = end_labels(step, census, plain, basin_tol)
     same = (label == label_rnd[:k]) & (label >= 0)
     return {"runs": k, "same": int(same.sum()), "distance": float(np.abs(acc - acc_rnd[:k]).max() / step.g)}
 
@@ -192,9 +199,7 @@ def run_census(traj, ens, measures, cfg, log=None):
     basin_tol = cc["basin_tol"] * step.g
     label_ens = np.stack([census.nearest(acc[i], basin_tol) for i in range(acc.shape[0])])
     ok_ens = tight.converged.values.astype(bool)
-    acc_rnd = np.array([step.accel(s) for s in rnd["impulse"]])
-    label_rnd = census.nearest(acc_rnd, basin_tol)
-    label_rnd[~rnd["converged"]] = -2
+    acc_rnd, label_rnd = end_labels(step, census, rnd, basin_tol)
     check = _plain_check(step, census, plain_check, acc_rnd, label_rnd, basin_tol)
     # stability under perturbation
     n_sol = len(census.accel)
