@@ -28,8 +28,9 @@ import snakemake.benchmark as _benchmark
 _benchmark.BENCHMARK_INTERVAL_SHORT = max(_benchmark.BENCHMARK_INTERVAL_SHORT, 5.0)
 
 # Snakemake's scheduler loop re-arms a one-second timer on each pass while jobs wait, and each
-# finished job starts one more chain of them: on the default run its main process used about
-# 457 s of CPU, stolen from the jobs.  One pending timer at a time (ncd.pipeline.workflow).
+# finished job starts one more chain of them: the loop ran about once a second per finished job
+# and its main process used 514 s of CPU on the default run, 28 s with one pending timer at a
+# time (ncd.pipeline.workflow.coalesce_reevaluations; workflow/README.md).
 from ncd.pipeline.workflow import coalesce_reevaluations
 
 coalesce_reevaluations()

@@ -468,7 +468,9 @@ def dag_table(jobs, root="."):
 
     Snakemake samples a job's process tree now and then, so its ``cpu_time`` misses
     children that end between samples (a default run: 3,317 s against 4,503 s of wall
-    time in single-thread jobs on an idle machine) and over-counts a notebook's kernel.
+    time in single-thread jobs on an idle machine); a notebook job's ``cpu_time`` also
+    counts Snakemake's own main process from its start (548 s for a 20-s notebook at the
+    end of a default run whose main process had used 514 s).
     On a machine that never runs more threads than cores (``-j`` at most the cores), a
     job holds its threads for its wall time: that time is its cost (``cpu_s``) and its
     time alone (``alone_s``), from which the critical path of the DAG is found
