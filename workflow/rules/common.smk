@@ -77,8 +77,8 @@ def ncd_sources(figure):
 
 # One input stands for a set of sources: results/code/<name>.sha256, the SHA-256 of each file,
 # rebuilt (rule code_stamp) when one of them is newer.  A computing rule lists that stamp instead
-# of its ~55 source files: Snakemake stats every input of every ready job each time it picks jobs
-# (about once a second); the stamps took a third off the main process's CPU on the reduced DAG
+# of its ~55 source files: Snakemake stats every input of every ready job each time it picks jobs;
+# the stamps took a third off the main process's CPU on the reduced DAG
 # (workflow/README.md).  Editing a source still reruns exactly the rules whose set holds it (the
 # stamp is newer than their outputs).
 CODE_SETS = {}
