@@ -113,3 +113,66 @@ def test_bad_input():
         lemke(np.eye(2), np.ones(3))
     with pytest.raises(ncd.InputError, match="W has shape"):
         frictional_lcp(np.eye(3), np.ones(4), [0.5, 0.5])
+
+
+def full_tableau_lemke(M, q, d, max_pivots, tol=1e-12):
+    """Lemke's method on the full tableau ``[I, -M, -d | q]``, written plainly: the
+    reference that the compact tableau of ``ncd.solver.lcp`` must follow pivot for pivot."""
+    n = len(q)
+    T = np.hstack([np.eye(n), -M, -d[:, None], q[:, None]])
+    basis = list(range(n))
+    row, entering = int(np.argmin(q / d)), 2 * n
+    for it in range(max_pivots):
+        T[row] /= T[row, entering]
+        for i in range(n):
+            if i != row and T[i, entering] != 0.0:
+                T[i] -= T[i, entering] * T[row]
+        leaving, basis[row] = basis[row], entering
+        if leaving == 2 * n:
+            return basis, 0, it + 1
+        entering = leaving + n if leaving < n else leaving - n
+        cand = [i for i in range(n) if T[i, entering] > tol]
+        if not cand:
+            return basis, 1, it + 1
+        for c in [2 * n + 1] + list(range(n)):      # lexicographic: q, then the columns of w
+            r = [T[i, c] / T[i, entering] for i in cand]
+            lo = min(r)
+            cand = [i for i, x in zip(cand, r) if x <= lo + tol * (1.0 + abs(lo))]
+            z0 = [i for i in cand if basis[i] == 2 * n]
+            if z0 or len(cand) == 1:
+                break
+        row = z0[-1] if z0 else cand[0]
+    return basis, 2, max_pivots
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_compact_tableau_follows_the_full_tableau_pivot_for_pivot(seed):
+    """The compact tableau stores only the nonbasic columns; its entries are computed by the
+    same operations as the full tableau's, so on positive definite, indefinite and singular
+    integer matrices (ties in the ratio test, some broken by the unit columns of basic w's),
+    with several covering vectors, it ends with the same status, pivot count and solution."""
+    from ncd.solver.lcp import LEMKE_STATUS, basis_solution
+    rng = np.random.default_rng(seed)
+    problems = []
+    for kind in range(3):
+        n = int(rng.integers(3, 25))
+        A = rng.normal(size=(n, n))
+        B = np.round(A[:, : n // 2])
+        M = A @ A.T if kind == 0 else (A if kind == 1 else B @ B.T)
+        q = rng.normal(size=n) - 0.5 if kind < 2 else np.round(2 * rng.normal(size=n))
+        problems.append((M, q))
+    for _ in range(8):       # q in {0, -1}: ties in q that basic columns of w break
+        B = rng.integers(-1, 2, size=(8, 3)).astype(float)
+        q = -rng.integers(0, 2, size=8).astype(float)
+        q[0] = -1.0                 # not all q >= 0 (lemke's trivial answer)
+        problems.append((B @ B.T, q))
+    for M, q in problems:
+        n = len(q)
+        for d in (np.ones(n), 10 ** rng.uniform(-1, 1, n)):
+            basis, status, pivots = full_tableau_lemke(M, q, d, 50 * n + 100)
+            z, info = lemke(M, q, covering=d)
+            assert info["pivots"] == pivots
+            if status == 0 and info["status"] == "solution":
+                np.testing.assert_array_equal(z, basis_solution(M, q, np.array(basis)))
+            else:
+                assert info["status"] in (LEMKE_STATUS[status], "inaccurate")

@@ -40,16 +40,29 @@ def _lemke(M, q, d, max_pivots, tol):
     """Lemke's method on the tableau ``[I, -M, -d | q]``; returns ``(basis, status, pivots)``.
 
     ``basis[i]`` is the variable basic in row ``i``: ``0..n-1`` are ``w``,
-    ``n..2n-1`` are ``z``, ``2n`` is ``z0``."""
+    ``n..2n-1`` are ``z``, ``2n`` is ``z0``.  The tableau is kept in compact form:
+    only the ``n + 1`` nonbasic columns and ``q`` (a basic variable's column is a unit
+    vector), the leaving variable taking the entering one's place.  That halves the
+    memory each pivot streams through, and every stored entry is computed by the same
+    operations as in the full tableau, so the path and the basis are the same bit for bit."""
     n = q.shape[0]
-    T = np.zeros((n, 2 * n + 2))
+    m1 = n + 1                      # nonbasic variables; column m1 holds q
+    T = np.zeros((n, n + 2))
     for i in range(n):
-        T[i, i] = 1.0
         for j in range(n):
-            T[i, n + j] = -M[i, j]
-        T[i, 2 * n] = -d[i]
-        T[i, 2 * n + 1] = q[i]
+            T[i, j] = -M[i, j]
+        T[i, n] = -d[i]
+        T[i, m1] = q[i]
     basis = np.arange(n)
+    col_of = np.empty(2 * n + 1, np.int64)      # compact column of a nonbasic variable, -1 if basic
+    var_of = np.empty(m1, np.int64)
+    row_of = np.empty(2 * n + 1, np.int64)      # row of a basic variable
+    for v in range(n):
+        col_of[v] = -1
+        row_of[v] = v
+    for k in range(m1):
+        var_of[k] = n + k
+        col_of[n + k] = k
     # first pivot: z0 enters, the row of the most negative q / d leaves
     row = 0
     best = np.inf
@@ -61,41 +74,58 @@ def _lemke(M, q, d, max_pivots, tol):
     entering = 2 * n
     cand = np.empty(n, np.int64)
     for it in range(max_pivots):
-        # pivot on (row, entering)
-        piv = T[row, entering]
-        for j in range(2 * n + 2):
+        # pivot on (row, entering): the leaving variable's unit column becomes column c
+        c = col_of[entering]
+        piv = T[row, c]
+        inv = 1.0 / piv
+        for j in range(n + 2):
             T[row, j] /= piv
+        T[row, c] = inv
         for i in range(n):
             if i != row:
-                f = T[i, entering]
+                f = T[i, c]
                 if f != 0.0:
-                    for j in range(2 * n + 2):
+                    for j in range(n + 2):
                         T[i, j] -= f * T[row, j]
+                    T[i, c] = 0.0 - f * inv
+                else:
+                    T[i, c] = 0.0
         leaving = basis[row]
         basis[row] = entering
+        row_of[entering] = row
+        col_of[entering] = -1
+        col_of[leaving] = c
+        var_of[c] = leaving
         if leaving == 2 * n:
             return basis, 0, it + 1
         # the complement of the leaving variable enters
         entering = leaving + n if leaving < n else leaving - n
+        e = col_of[entering]
         # lexicographic minimum ratio test over rows with a positive pivot entry
         m = 0
         for i in range(n):
-            if T[i, entering] > tol:
+            if T[i, e] > tol:
                 cand[m] = i
                 m += 1
         if m == 0:
             return basis, 1, it + 1
         z0_row = -1
         for col in range(-1, n):
-            c = 2 * n + 1 if col < 0 else col
+            # the ratio column: q, then the columns of w_0.. (a basic w's is a unit vector)
+            cc = m1 if col < 0 else col_of[col]
+            unit = -1 if cc >= 0 else row_of[col]
             lo = np.inf
             for k in range(m):
-                r = T[cand[k], c] / T[cand[k], entering]
+                i = cand[k]
+                num = T[i, cc] if cc >= 0 else (1.0 if i == unit else 0.0)
+                r = num / T[i, e]
                 if r < lo:
                     lo = r
             keep = 0
             for k in range(m):
-                r = T[cand[k], c] / T[cand[k], entering]
+                i = cand[k]
+                num = T[i, cc] if cc >= 0 else (1.0 if i == unit else 0.0)
+                r = num / T[i, e]
                 if r <= lo + tol * (1.0 + abs(lo)):
                     cand[keep] = cand[k]
                     keep += 1
