@@ -11,6 +11,7 @@ import subprocess
 from pathlib import Path
 
 import nbformat
+import numpy as np
 import pytest
 from bs4 import BeautifulSoup
 
@@ -353,6 +354,39 @@ def test_save_records_the_layout_in_the_png(tmp_path):
     assert lay["dpi"] == 150 and lay["overlaps"] == [] and lay["width_in"] == 4 and fig.dpi == 72
     assert lay["min_font_pt"] == min(11, ax.xaxis.get_ticklabels()[0].get_fontsize())
     plt.close(fig)
+
+
+def test_save_rasterizes_dense_clouds_in_the_pdf_only(tmp_path):
+    """``save`` writes the PNG first, then rasterizes in the PDF the artists that draw more
+    than DENSE_POINTS markers or paths (a scatter cloud, a line of dots); a line without
+    markers, a few markers and the axes stay vectors.  The rasterized PDF is several times
+    smaller than the all-vector one."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from ncd.pages.notebook import DENSE_POINTS, save
+
+    rng = np.random.default_rng(0)
+    n = 20 * DENSE_POINTS
+
+    def figure():
+        fig, ax = plt.subplots(figsize=(4, 3))
+        cloud = ax.scatter(*rng.normal(size=(2, n)), s=1)
+        dots, = ax.plot(*rng.normal(size=(2, n)), ".", ms=1)
+        curve, = ax.plot(np.linspace(0, 1, n), np.linspace(0, 1, n) ** 2, "-")
+        few, = ax.plot([0, 1], [0, 1], "o")
+        return fig, (cloud, dots, curve, few)
+
+    fig, artists = figure()
+    out = type("Out", (), {"png": str(tmp_path / "f.png"), "pdf": str(tmp_path / "f.pdf")})()
+    save(fig, out, dpi=100)
+    assert [a.get_rasterized() for a in artists] == [True, True, False, False]
+    plain, _ = figure()
+    plain.savefig(tmp_path / "plain.pdf")
+    assert (tmp_path / "f.pdf").stat().st_size < 0.25 * (tmp_path / "plain.pdf").stat().st_size
+    plt.close("all")
 
 
 def test_layout_skips_undrawn_ticks_of_an_inset_colorbar():

@@ -18,6 +18,7 @@ import yaml
 MARKERS = ("Snakefile", "config.yaml")
 LAYOUT_KEY = "ncd-text-layout"   # the PNG text chunk holding text_layout's record
 MIN_FONT_PT = 9.0                # the smallest font a reader should meet at the page's size
+DENSE_POINTS = 2000              # markers or paths of one artist above which the PDF rasterizes it
 
 
 class NotebookError(RuntimeError):
@@ -131,9 +132,29 @@ def text_layout(fig, tol_px=1.0):
             "dpi": float(fig.dpi), "width_in": float(fig.get_figwidth())}
 
 
+def rasterize_dense(fig, limit=None):
+    """Mark every artist of ``fig`` drawing more than ``limit`` (:data:`DENSE_POINTS`) points
+    or paths as rasterized; returns how many.  A cloud of 10^4-10^5 markers written as PDF
+    vectors makes a large file that is slow to write and to view, and no reader zooms into
+    single dots; axes, text, outlines and polygons stay vectors."""
+    limit = DENSE_POINTS if limit is None else limit
+    count = 0
+    for ax in fig.axes:
+        for artist in [*ax.collections, *ax.lines]:
+            if hasattr(artist, "get_xdata"):
+                n = len(artist.get_xdata()) if artist.get_marker() not in (None, "", "None", " ") else 0
+            else:
+                n = max(len(artist.get_offsets()), len(artist.get_paths()))
+            if n > limit:
+                artist.set_rasterized(True)
+                count += 1
+    return count
+
+
 def save(fig, output, dpi=130, show=False, **kwargs):
     """Save ``fig`` to ``output.png`` and ``output.pdf`` (a PDF without creation date, so that
-    reruns give the same bytes); ``show`` also displays the PNG in the notebook.  The PNG
+    reruns give the same bytes; its dense clouds rasterized at ``dpi``,
+    :func:`rasterize_dense`); ``show`` also displays the PNG in the notebook.  The PNG
     carries :func:`text_layout` at the saved dpi (text chunk :data:`LAYOUT_KEY`)."""
     Path(output.png).parent.mkdir(parents=True, exist_ok=True)
     shown_dpi = fig.dpi                  # measured at the saved dpi, then displayed as before
@@ -141,7 +162,8 @@ def save(fig, output, dpi=130, show=False, **kwargs):
     layout = json.dumps(text_layout(fig), ensure_ascii=True)
     fig.set_dpi(shown_dpi)
     fig.savefig(output.png, dpi=dpi, metadata={LAYOUT_KEY: layout}, **kwargs)
-    fig.savefig(output.pdf, metadata={"CreationDate": None}, **kwargs)
+    rasterize_dense(fig)
+    fig.savefig(output.pdf, dpi=dpi, metadata={"CreationDate": None}, **kwargs)
     if show:
         from IPython.display import Image, display
 
