@@ -360,7 +360,8 @@ def test_save_rasterizes_dense_clouds_in_the_pdf_only(tmp_path):
     """``save`` writes the PNG first, then rasterizes in the PDF the artists that draw more
     than DENSE_POINTS markers or paths (a scatter cloud, a line of dots); a line without
     markers, a few markers and the axes stay vectors.  The rasterized PDF is several times
-    smaller than the all-vector one."""
+    smaller than the all-vector one.  The layout engine, frozen while the files are written,
+    is the figure's again afterwards."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -372,7 +373,7 @@ def test_save_rasterizes_dense_clouds_in_the_pdf_only(tmp_path):
     n = 20 * DENSE_POINTS
 
     def figure():
-        fig, ax = plt.subplots(figsize=(4, 3))
+        fig, ax = plt.subplots(figsize=(4, 3), layout="constrained")
         cloud = ax.scatter(*rng.normal(size=(2, n)), s=1)
         dots, = ax.plot(*rng.normal(size=(2, n)), ".", ms=1)
         curve, = ax.plot(np.linspace(0, 1, n), np.linspace(0, 1, n) ** 2, "-")
@@ -380,9 +381,11 @@ def test_save_rasterizes_dense_clouds_in_the_pdf_only(tmp_path):
         return fig, (cloud, dots, curve, few)
 
     fig, artists = figure()
+    engine = fig.get_layout_engine()
     out = type("Out", (), {"png": str(tmp_path / "f.png"), "pdf": str(tmp_path / "f.pdf")})()
     save(fig, out, dpi=100)
     assert [a.get_rasterized() for a in artists] == [True, True, False, False]
+    assert fig.get_layout_engine() is engine            # frozen for the two files only
     plain, _ = figure()
     plain.savefig(tmp_path / "plain.pdf")
     assert (tmp_path / "f.pdf").stat().st_size < 0.25 * (tmp_path / "plain.pdf").stat().st_size

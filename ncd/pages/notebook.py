@@ -161,9 +161,16 @@ def save(fig, output, dpi=130, show=False, **kwargs):
     fig.set_dpi(dpi)
     layout = json.dumps(text_layout(fig), ensure_ascii=True)
     fig.set_dpi(shown_dpi)
+    # the layout engine placed the axes in that draw at the saved dpi: keep those positions
+    # for both files (the PNG is then the layout measured) instead of solving it in each savefig
+    engine = fig.get_layout_engine()
+    if engine is not None:
+        fig.set_layout_engine("none")
     fig.savefig(output.png, dpi=dpi, metadata={LAYOUT_KEY: layout}, **kwargs)
     rasterize_dense(fig)
     fig.savefig(output.pdf, dpi=dpi, metadata={"CreationDate": None}, **kwargs)
+    if engine is not None:
+        fig.set_layout_engine(engine)
     if show:
         from IPython.display import Image, display
 
