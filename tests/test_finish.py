@@ -234,3 +234,62 @@ def test_shared_delassus_is_built_once_and_changes_nothing(column, lp_now):
         with pytest.raises(ncd.InputError, match="delassus"):
             ncd.solve_discs(scene, fresh.contacts, vel, spin, settings=ncd.SolverSettings(local_exact=True),
                             delassus=bad)
+
+
+def test_status_system_and_min_norm_solve_match_their_plain_definitions():
+    """``status_system`` (vectorized) builds, entry for entry, the matrices of its plain
+    per-contact definition (stick: two unknowns and rows; slide: ``s_t = -+mu s_n``, the
+    row ``U_n``; open: none), and ``min_norm_solve`` gives bit for bit the answer of the
+    system assembled by ``scipy.sparse.bmat``: the census's patterns stay the same."""
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spla
+
+    from ncd.solver.single_contact import SLIDE_BACKWARD, SLIDE_FORWARD
+
+    def plain(mu, status):
+        prow, pcol, pval, srow, col = [], [], [], [], 0
+        for c, st in enumerate(status):
+            if st == STICK or st > SLIDE_BACKWARD:
+                prow += [2 * c, 2 * c + 1]
+                pcol += [col, col + 1]
+                pval += [1.0, 1.0]
+                srow += [2 * c, 2 * c + 1]
+                col += 2
+            elif st in (SLIDE_FORWARD, SLIDE_BACKWARD):
+                prow += [2 * c, 2 * c + 1]
+                pcol += [col, col]
+                pval += [1.0, (-1.0 if st == SLIDE_FORWARD else 1.0) * mu[c]]
+                srow.append(2 * c)
+                col += 1
+        n = len(status)
+        return (sp.csr_matrix((pval, (prow, pcol)), shape=(2 * n, col)),
+                sp.csr_matrix((np.ones(col), (srow, np.arange(col))), shape=(2 * n, col)))
+
+    rng = np.random.default_rng(5)
+    for n in (0, 1, 7, 40):
+        status = rng.choice([NO_CONTACT, STICK, SLIDE_FORWARD, SLIDE_BACKWARD, SLIDE_BACKWARD + 1], n).astype(np.int8)
+        mu = rng.uniform(0.1, 1.0, n)
+        for got, want in zip(finish.status_system(mu, status), plain(mu, status)):
+            assert got.shape == want.shape
+            for a in ("indptr", "indices", "data"):
+                np.testing.assert_array_equal(getattr(got, a), getattr(want, a))
+        if n < 7:
+            continue
+        P, S = finish.status_system(mu, status)
+        A = sp.random(2 * n, 2 * n, density=0.2, random_state=n)
+        K = (S.T @ (A @ A.T) @ P).tocsr()
+        r = K @ rng.normal(size=K.shape[1])
+        m = K.shape[0]
+        eps = 1e-10 * abs(K).sum(axis=1).max() ** 2
+        lu = spla.splu(sp.bmat([[sp.identity(m), K.T], [K, -eps * sp.identity(m)]], format="csc"),
+                       permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options={"SymmetricMode": True})
+        d, prev = np.zeros(m), np.inf                  # min_norm_solve's refinements, on bmat's system
+        for _ in range(finish.REFINE):
+            e = r - K @ d
+            if np.linalg.norm(e) <= 1e-15 * np.linalg.norm(r) or np.linalg.norm(e) > 0.5 * prev:
+                break
+            prev = np.linalg.norm(e)
+            d += lu.solve(np.concatenate([np.zeros(m), e]))[:m]
+        got = finish.min_norm_solve(K, r)
+        np.testing.assert_array_equal(got, d)
+        np.testing.assert_allclose(K @ got, r, atol=1e-8 * np.abs(r).max())
