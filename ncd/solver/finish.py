@@ -117,7 +117,8 @@ def min_norm_solve(K, r, eps_rel=1e-10):
 def _kkt(K, eps):
     """``[[I, K^T], [K, -eps I]]`` (CSC) of the square ``K``, entries in the order of
     ``scipy.sparse.bmat`` (blocks row by row, each in COO order), so the LU is the same,
-    without bmat's per-block conversions (a third of a census pattern's time)."""
+    without bmat's per-block conversions (on the census, 14 s of its 81 s of minimum-norm
+    solves)."""
     m = K.shape[0]
     Kc = K.tocoo()
     d = np.arange(m)
