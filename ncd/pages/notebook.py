@@ -134,11 +134,10 @@ def text_layout(fig, tol_px=1.0):
 
 def rasterize_dense(fig, limit=None):
     """Mark every artist of ``fig`` drawing more than ``limit`` (:data:`DENSE_POINTS`) points
-    or paths as rasterized; returns how many.  A cloud of 10^4-10^5 markers written as PDF
+    or paths as rasterized.  A cloud of 10^4-10^5 markers written as PDF
     vectors makes a large file that is slow to write and to view, and no reader zooms into
     single dots; axes, text, outlines and polygons stay vectors."""
     limit = DENSE_POINTS if limit is None else limit
-    count = 0
     for ax in fig.axes:
         for artist in [*ax.collections, *ax.lines]:
             if hasattr(artist, "get_xdata"):
@@ -147,8 +146,6 @@ def rasterize_dense(fig, limit=None):
                 n = max(len(artist.get_offsets()), len(artist.get_paths()))
             if n > limit:
                 artist.set_rasterized(True)
-                count += 1
-    return count
 
 
 def save(fig, output, dpi=130, show=False, **kwargs):

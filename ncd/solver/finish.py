@@ -67,7 +67,7 @@ def status_system(mu, status):
     A sticking contact has two unknowns ``(s_n, s_t)`` and two rows ``U_n = U_t = 0``, a
     sliding one one unknown ``s_n`` (``s_t = -+mu s_n``) and the row ``U_n = 0``, an open one
     none; unknowns in contact order."""
-    status = np.asarray(status)
+    status, mu = np.asarray(status), np.asarray(mu, float)
     n = len(status)
     stick = (status == STICK) | (status > SLIDE_BACKWARD)       # FALLBACK reads as stick
     slide = (status == SLIDE_FORWARD) | (status == SLIDE_BACKWARD)
@@ -75,16 +75,16 @@ def status_system(mu, status):
     width = np.where(stick, 2, np.where(slide, 1, 0))
     first = np.cumsum(width) - width                             # first unknown of each contact
     col = int(width.sum())
-    c_st, c_sl = np.nonzero(stick)[0], np.nonzero(slide)[0]
-    # P: stick (2c, x), (2c+1, x+1); slide (2c, x), (2c+1, x) = sign mu; entries in contact order
-    rows = np.concatenate([np.column_stack([2 * c_st, 2 * c_st + 1]), np.column_stack([2 * c_sl, 2 * c_sl + 1])])
-    cols = np.concatenate([np.column_stack([first[c_st], first[c_st] + 1]),
-                           np.column_stack([first[c_sl], first[c_sl]])])
-    vals = np.concatenate([np.ones((len(c_st), 2)), np.column_stack([np.ones(len(c_sl)), sign[c_sl] * mu[c_sl]])])
-    order = np.argsort(np.concatenate([c_st, c_sl]), kind="stable")
-    P = sp.csr_matrix((vals[order].ravel(), (rows[order].ravel(), cols[order].ravel())), shape=(2 * n, col))
+    # per closed contact c: P[2c, x] = 1 and P[2c+1, x+1] = 1 (stick) or P[2c+1, x] = sign mu (slide)
+    c = np.nonzero(width)[0]
+    rows = np.column_stack([2 * c, 2 * c + 1]).ravel()
+    cols = np.column_stack([first[c], first[c] + width[c] - 1]).ravel()
+    vals = np.column_stack([np.ones(len(c)), np.where(stick[c], 1.0, sign[c] * mu[c])]).ravel()
+    P = sp.csr_matrix((vals, (rows, cols)), shape=(2 * n, col))
     srow = np.empty(col, np.int64)
-    srow[first[c_st]], srow[first[c_st] + 1], srow[first[c_sl]] = 2 * c_st, 2 * c_st + 1, 2 * c_sl
+    srow[first[c]] = 2 * c
+    c_st = np.nonzero(stick)[0]
+    srow[first[c_st] + 1] = 2 * c_st + 1
     S = sp.csr_matrix((np.ones(col), (srow, np.arange(col))), shape=(2 * n, col))
     return P, S
 

@@ -55,13 +55,11 @@ def _lemke(M, q, d, max_pivots, tol):
         T[i, m1] = q[i]
     basis = np.arange(n)
     col_of = np.empty(2 * n + 1, np.int64)      # compact column of a nonbasic variable, -1 if basic
-    var_of = np.empty(m1, np.int64)
     row_of = np.empty(2 * n + 1, np.int64)      # row of a basic variable
     for v in range(n):
         col_of[v] = -1
         row_of[v] = v
     for k in range(m1):
-        var_of[k] = n + k
         col_of[n + k] = k
     # first pivot: z0 enters, the row of the most negative q / d leaves
     row = 0
@@ -95,7 +93,6 @@ def _lemke(M, q, d, max_pivots, tol):
         row_of[entering] = row
         col_of[entering] = -1
         col_of[leaving] = c
-        var_of[c] = leaving
         if leaving == 2 * n:
             return basis, 0, it + 1
         # the complement of the leaving variable enters
