@@ -4,7 +4,7 @@ The equilibrium forces of a packing form the polytope
 ``A ∩ C = {r : H r + F = 0, |r_t| <= mu r_n}`` (:class:`ncd.exact.polytope.ForcePolytope`
 builds its scaled equations).  :class:`ExactSet` keeps one HiGHS model (``highspy``)
 whose only rows are the equilibrium equations -- the Coulomb sectors are column
-bounds (:func:`cone_columns`) -- and changes only its objective between queries, so
+bounds (:func:`ncd.solver.cone.cone_columns`) -- and changes only its objective between queries, so
 that each LP restarts (primal simplex) from the previous optimal basis:
 
 * :meth:`ExactSet.interval`: exact min and max of a linear functional;
@@ -23,6 +23,7 @@ import scipy.sparse as sp
 from ncd.core import validate
 from ncd.exact.polygon import outside_distance, support_polygon
 from ncd.exact.polytope import ForcePolytope, PolytopeError
+from ncd.solver.cone import cone_columns
 
 FEAS_TOL = 1e-10
 
@@ -244,7 +245,7 @@ class ExactSet:
 
     def _homogenised(self):
         """The Charnes-Cooper model of A ∩ C: columns ``(z, t)`` (``z`` the sector columns
-        of :func:`cone_columns`), rows ``A_eq T z - b_eq t = 0`` and a normalisation row
+        of :func:`ncd.solver.cone.cone_columns`), rows ``A_eq T z - b_eq t = 0`` and a normalisation row
         (empty until :meth:`_fractional` fills it), built on first use."""
         if self._cc is None:
             fp = self.fp
@@ -289,7 +290,7 @@ class ExactSet:
 
 def sector_model(A_eq, b_eq, T, upper, **options):
     """A HiGHS model of ``A_eq T y = b_eq``, ``0 <= y <= upper`` (the Coulomb sectors as
-    column bounds, :func:`cone_columns`), zero cost, silent, with the given options."""
+    column bounds, :func:`ncd.solver.cone.cone_columns`), zero cost, silent, with the given options."""
     A = (A_eq @ T).tocsc()
     n = A.shape[1]
     lp = highspy.HighsLp()
@@ -309,28 +310,6 @@ def sector_model(A_eq, b_eq, T, upper, **options):
         h.setOptionValue(k, v)
     h.passModel(lp)
     return h
-
-
-def cone_columns(mu):
-    """The Coulomb sectors as bounds: ``r = T y`` with ``y >= 0`` (``y <= upper``).
-
-    Per contact ``y = (a, b) = (mu r_n + r_t, mu r_n - r_t)``, so that ``|r_t| <= mu r_n``
-    is ``a, b >= 0`` (``r_n = (a + b) / (2 mu)``, ``r_t = (a - b) / 2``); a frictionless
-    contact has ``r_n = a``, ``r_t = 0`` (``b`` fixed at 0).  The LP then has only the
-    equilibrium rows, and every LP point satisfies Coulomb's law to round-off."""
-    mu = np.asarray(mu, dtype=float)
-    k = len(mu)
-    i = np.arange(k)
-    rough = mu > 0
-    inv = np.where(rough, 0.5 / np.where(rough, mu, 1.0), 1.0)
-    rows = np.concatenate([2 * i, 2 * i, 2 * i + 1, 2 * i + 1])
-    cols = np.concatenate([2 * i, 2 * i + 1, 2 * i, 2 * i + 1])
-    vals = np.concatenate([inv, np.where(rough, inv, 0.0), np.where(rough, 0.5, 0.0), np.where(rough, -0.5, 0.0)])
-    T = sp.csr_matrix((vals, (rows, cols)), shape=(2 * k, 2 * k))
-    T.eliminate_zeros()
-    upper = np.full(2 * k, highspy.kHighsInf)
-    upper[2 * i[~rough] + 1] = 0.0
-    return T, upper
 
 
 def _min_norm(K, r, eps=1e-12, refine=20):

@@ -12,13 +12,14 @@ of the set along each contact, not Unger et al.'s eta_U, a standard deviation).
 import highspy
 import numpy as np
 
-from ncd.exact.exact_set import cone_columns, sector_model
+from ncd.exact.exact_set import sector_model
 from ncd.exact.polytope import ForcePolytope, PolytopeError
+from ncd.solver.cone import cone_columns
 
 
 class _Model:
     """One HiGHS model of the scaled ``A ∩ C``, Coulomb sectors as column bounds
-    (:func:`ncd.exact.exact_set.cone_columns`), so its only rows are the equilibrium equations.
+    (:func:`ncd.solver.cone.cone_columns`), so its only rows are the equilibrium equations.
 
     Queries take and return scaled forces ``x``; only the objective changes between solves,
     and :meth:`minimize` can restart from a stored basis: bounds instead of rows, and a
