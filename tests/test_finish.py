@@ -1,6 +1,4 @@
 """Finishing stage: NLGS, then the projection on its statuses' polyhedron (LP)."""
-from types import SimpleNamespace
-
 import numpy as np
 import pytest
 from step_checks import contact_velocities as _velocities
@@ -379,39 +377,3 @@ def test_projection_matches_a_row_by_row_formulation():
             assert abs(info["correction"] - ref) <= 1e-7 * max(ref, 1.0), (trial, info["correction"], ref)
             assert np.abs(s.ravel() - s0).sum() == pytest.approx(info["correction"], rel=1e-12)
     assert found[True] >= 20 and found[False] >= 5
-
-
-def _scripted_polish(monkeypatch, profile, sweeps0=4000, max_sweeps=200000):
-    """finish.polish on a scripted NLGS whose residual after ``t`` sweeps is ``profile(t)``
-    (the iterate carries ``t``); returns the sweep counts at which it asked for a projection
-    (every projection reports an empty polyhedron) and polish's output."""
-    n = 2
-    asked, done = [], [sweeps0]
-    monkeypatch.setattr(finish, "relative_residual", lambda s, U, mu, rho, scale: profile(s[0, 0]))
-
-    def project(lp, s, status, elastic=0.0):
-        asked.append(int(s[0, 0]))
-        return None, None, {"status": "Infeasible", "iterations": 0}
-    monkeypatch.setattr(finish, "project", project)
-
-    def more(k):
-        done[0] += k
-        return np.full((n, 2), float(done[0])), np.full(n, STICK, np.int8)
-    lp = SimpleNamespace(b=np.zeros(2 * n))                  # rest_status reads the bias only
-    out = finish.polish(lambda: lp, np.zeros((2 * n, 2 * n)), np.zeros(2 * n), np.full(n, 0.5), np.ones(n), 1.0,
-                        np.full((n, 2), float(sweeps0)), np.full(n, STICK, np.int8), 1e-10, more, max_sweeps, sweeps0)
-    return asked, out
-
-
-def test_stalling_nlgs_goes_to_the_projection_after_its_rate_is_measured_again(monkeypatch):
-    """NLGS's rate over the first chunk (a quarter of the sweeps made, here 1000) predicts
-    finish_tol within LP_SWEEPS, then NLGS stalls: the stage measures the rate again after
-    at most RECHECK first chunks and projects, instead of sweeping the whole prediction
-    (about 59,000 sweeps here).  A steady NLGS is left to finish alone, without an LP."""
-    rate = 2.3e-4                                   # per sweep: 1e-5 -> 1e-10 in about 50,000 sweeps
-    stall = lambda t: 1e-5 * np.exp(-rate * min(t - 4000, 1000) - 1e-6 * max(t - 5000, 0))  # noqa: E731
-    asked, _ = _scripted_polish(monkeypatch, stall)
-    assert asked and asked[0] - 4000 <= (1 + finish.RECHECK) * 1000
-    steady = lambda t: 1e-5 * np.exp(-rate * (t - 4000))                                      # noqa: E731
-    asked, out = _scripted_polish(monkeypatch, steady)
-    assert asked == [] and out[4] and out[2] <= 1e-10
