@@ -3,8 +3,8 @@
 NLGS settles every contact's *status* (open, stick, slide forward or backward) long
 before its impulses converge.  In 2-D the Coulomb cone is polyhedral, so the one-step
 solutions sharing a status pattern form a polyhedron (:mod:`ncd.solver.finish_lp`).
-:func:`polish` lets NLGS go on while its own rate, measured again every few chunks,
-predicts ``finish_tol`` within :data:`LP_SWEEPS` sweeps; otherwise it projects the iterate on the polyhedron of its
+:func:`polish` lets NLGS go on while its own rate predicts ``finish_tol`` within
+:data:`LP_SWEEPS` sweeps; otherwise it projects the iterate on the polyhedron of its
 statuses (nearest point in L1, an LP) and accepts the projection only if its residual
 is ``<= finish_tol`` and it moves the impulses by at most :data:`MAX_CORRECTION`, so
 that it stays on the solution NLGS approaches instead of jumping to another one of an
@@ -26,9 +26,6 @@ from ncd.solver.single_contact import NO_CONTACT, SLIDE_BACKWARD, SLIDE_FORWARD,
 
 FIRST_CHUNK = 50         # NLGS sweeps (at least; a quarter of those made) that measure NLGS's rate
 LP_SWEEPS = 50000        # NLGS goes on while its rate predicts finish_tol within this many sweeps
-RECHECK = 4              # ... in chunks of at most this many first chunks, its rate measured again after each:
-                         # on Figure 4's pile the first chunk's rate predicted 1e-10 within 30,000-56,000
-                         # sweeps, and NLGS stalled near 1e-6 in most runs
 MAX_ATTEMPTS = 3         # failed projections (an empty polyhedron is a long LP) before NLGS alone
 REST_GATE = 1e-5         # the rest polyhedron is tried from iterates this close only (far ones: long LPs, rejected)
 MAX_CORRECTION = 0.05    # a projection moving the impulses by more (relative L1) is a jump: rejected
@@ -164,8 +161,8 @@ def polish(make_lp, W, q, mu, rho, scale, s0, status0, tol, more_sweeps, max_swe
         ahead = np.inf if rate is None or rate <= 0 else np.log(res / tol) / rate
         if rate is None and FIRST_CHUNK > 0:
             k = min(chunk, max_sweeps - extra)                                # NLGS's rate first
-        elif ahead <= LP_SWEEPS:                                          # NLGS converges: let it, and check
-            k = int(min(np.ceil(1.2 * ahead) + 10, RECHECK * chunk, max_sweeps - extra))
+        elif ahead <= LP_SWEEPS:
+            k = int(min(np.ceil(1.2 * ahead) + 10, max_sweeps - extra))     # NLGS converges: let it
         elif attempts >= MAX_ATTEMPTS:
             k = min(chunk, max_sweeps - extra)
             chunk *= 4
