@@ -77,7 +77,8 @@ def project(lp, s0, status, elastic=0.0):
     m = 2 * n
     # impulses in Coulomb sector coordinates s / S = T z (ncd.solver.cone), so the cone and
     # the sliding statuses are column bounds: a quarter fewer rows than cone rows, the same
-    # polyhedron (and, measured on Figure 4's pile, the same vertex in 28 % less time)
+    # polyhedron, and HiGHS's LPs take about a quarter less time (docs/solvers.md: the
+    # outcome of a few of Figure 4's runs changes with the formulation)
     T, upper = cone_columns(lp.mu)
     rough = lp.mu > 0
     z_hi = upper.copy()
