@@ -8,7 +8,7 @@ import ncd
 from ncd.core.scene import make_scene
 from ncd.solver import convergence, finish, finish_lp
 from ncd.solver.finish import check_solution
-from ncd.solver.single_contact import NO_CONTACT, STICK
+from ncd.solver.single_contact import NO_CONTACT, SLIDE_BACKWARD, SLIDE_FORWARD, STICK
 from ncd.studies import scenes
 
 H = 1e-3
@@ -244,8 +244,6 @@ def test_status_system_and_min_norm_solve_match_their_plain_definitions():
     import scipy.sparse as sp
     import scipy.sparse.linalg as spla
 
-    from ncd.solver.single_contact import SLIDE_BACKWARD, SLIDE_FORWARD
-
     def plain(mu, status):
         prow, pcol, pval, srow, col = [], [], [], [], 0
         for c, st in enumerate(status):
@@ -301,7 +299,6 @@ def _l1_reference(W, q, mu, s0, status):
     scipy's HiGHS: a formulation independent of finish_lp's sector columns."""
     from scipy.optimize import linprog
 
-    from ncd.solver.single_contact import SLIDE_BACKWARD, SLIDE_FORWARD
     n = len(mu)
     m = 2 * n
     I = np.eye(m)
@@ -349,7 +346,6 @@ def test_projection_matches_a_row_by_row_formulation():
     with explicit rows, for every status (open, stick, slide either way), frictionless
     contacts included, on polyhedra built non-empty around a known solution and on
     random, mostly empty, ones."""
-    from ncd.solver.single_contact import SLIDE_BACKWARD, SLIDE_FORWARD
     rng = np.random.default_rng((0, 2005))
     found = {True: 0, False: 0}
     for trial in range(40):
