@@ -13,6 +13,8 @@ from ncd.pipeline.config import ConfigError, check_config
 SCHEMAS = ROOT / "workflow" / "schemas"
 CONFIG = yaml.safe_load((ROOT / "config.yaml").read_text())
 REDUCED = yaml.safe_load((ROOT / "tests" / "config_reduced.yaml").read_text())
+QUICK = yaml.safe_load((ROOT / "config" / "quick.yaml").read_text())
+REALIZATIONS = {"runs", "piles", "seeds", "random_runs"}     # counts of ensemble members, piles, flows
 RULE_FILES = [f for f in CONFIG if (ROOT / "workflow" / "rules" / f"{f}.smk").exists() and f != "bench"]
 
 
@@ -37,6 +39,27 @@ def test_the_shipped_configs_pass():
     check_config(CONFIG, RULE_FILES, SCHEMAS)
     check_config(merged(CONFIG, REDUCED), RULE_FILES, SCHEMAS)
     assert issubclass(ConfigError, InputError) and issubclass(ConfigError, ValueError)
+
+
+def leaves(tree, path=()):
+    for key, value in tree.items():
+        if isinstance(value, dict):
+            yield from leaves(value, path + (key,))
+        else:
+            yield path + (key,), value
+
+
+def test_the_quick_overlay_only_draws_fewer_realizations():
+    """``config/quick.yaml`` keeps every size, tolerance, method and seed of config.yaml:
+    it sets realization counts only, each below the default's and at least half of it."""
+    check_config(merged(CONFIG, QUICK), RULE_FILES, SCHEMAS)
+    assert len(list(leaves(QUICK))) >= 8
+    for path, value in leaves(QUICK):
+        default = CONFIG
+        for key in path:
+            default = default[key]
+        assert path[-1] in REALIZATIONS, f"{'.'.join(path)} is not a realization count"
+        assert type(value) is int and default / 2 <= value < default, (path, value, default)
 
 
 # the ten configs that passed the schemas and planned jobs, with the text the error must hold
