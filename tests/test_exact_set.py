@@ -87,3 +87,47 @@ def test_angle_range_equals_the_angles_of_the_exact_polygon(pile):
         lo, hi = resultant_angle(poly["vertices"], outer[k])
         r = es.angle_range(L, outer[k])
         assert abs(r["lo"] - lo) <= 1e-8 and abs(r["hi"] - hi) <= 1e-8
+
+
+def test_clp_simplex_gives_the_highs_angle_ranges_intervals_and_polygons(pile):
+    """``simplex="clp"`` (HiGHS's first basis, then CLP from basis to basis, the route of the
+    10^4-grain piles) against HiGHS alone on the same cuts and the same sequence of LPs: the
+    same angle ranges to 1e-9 degree, p_min and the intervals of the resultants' components
+    to 1e-9 of the force scale, the same exact polygon areas, and LP points in A ∩ C."""
+    H, F, mu, C, outer = pile
+    ref, clp = ExactSet(H, F, mu), ExactSet(H, F, mu, simplex="clp")
+    assert clp.simplex == "clp" and clp._clp is None
+    clp.minimize(np.zeros(clp.n))                                     # HiGHS's first LP, then CLP
+    widths = []
+    for k in range(len(outer)):
+        L = C[2 * k: 2 * k + 2]
+        g = L @ ref.minimize(np.zeros(ref.n))[1]
+        phi = np.degrees(np.arctan2(-g[1], outer[k] * g[0])) + 3.0    # the same reference for both
+        a, b = ref.angle_range(L, outer[k], ref=phi), clp.angle_range(L, outer[k], ref=phi)
+        assert clp._clp is not None
+        assert abs(a["lo"] - b["lo"]) <= 1e-9 and abs(a["hi"] - b["hi"]) <= 1e-9
+        assert abs(a["p_min"] - b["p_min"]) <= 1e-9 * ref.scale and b["bound"] <= 1e-9
+        eq, co = clp.fp.violations(b["points"])
+        assert eq.max() <= 1e-9 and co.max() <= 1e-9
+        assert np.abs(ref.intervals(L) - clp.intervals(L)).max() <= 1e-9 * ref.scale
+        widths.append(a["hi"] - a["lo"])
+    assert min(widths) > 1.0
+    L = C[:2]
+    pa, pb = ref.polygon(L, n_dirs=36), clp.polygon(L, n_dirs=36)
+    assert pa["exact"] and pb["exact"]
+    assert abs(pa["inner_area"] - pb["inner_area"]) <= 1e-9 * max(pa["inner_area"], 1e-300)
+
+
+def test_clp_simplex_reports_an_empty_polytope_and_a_bad_choice():
+    """An empty A ∩ C is a PolytopeError by either simplex, after the first LP too; an unknown
+    ``simplex`` is an InputError naming the argument, before any model is built."""
+    from ncd.core.errors import InputError
+    from ncd.exact.polytope import PolytopeError
+    scene = lattice_pile(n_base=3, mu=0.3)
+    c, H, F = balanced(scene)
+    es = ExactSet(H, F, c.mu, simplex="clp")
+    es.minimize(np.zeros(es.n))
+    with pytest.raises(PolytopeError, match="empty"):
+        ExactSet(H, 1e3 * np.abs(F) + 1.0, c.mu, simplex="clp").minimize(np.zeros(es.n))
+    with pytest.raises(InputError, match="simplex = 'cplex'"):
+        ExactSet(H, F, c.mu, simplex="cplex")

@@ -259,6 +259,11 @@ def test_histories_use_the_same_grains(piles):
 
 
 def test_exact_ranges_contain_the_history_angle(analysis, results):
+    check_exact_ranges(analysis)
+
+
+def check_exact_ranges(analysis):
+    """Every exact range computed, certified and holding the history angle."""
     cfg = yaml.safe_load(analysis.attrs["config_yaml"])
     done = analysis.exact_computed.values
     assert done.sum() == 2 * min(cfg["exact"]["piles"], cfg["piles"]) and done[:, 0].all()
@@ -364,6 +369,14 @@ def test_size_study_compares_every_size(size, results):
         assert np.all(size.arching_mean.values[z] <= size.arching_hi.values[z] + 1e-12)
     p = size.arching_size_p.values
     assert np.isnan(p[0]).all() and np.all((p[1:] > 0) & (p[1:] <= 1))
+
+
+def test_the_largest_piles_exact_ranges_by_clp_hold_the_history_angle(size, results):
+    """The size overlay's exact ranges come from CLP's simplex (as config/large.yaml's): the
+    same checks as the default piles' HiGHS ranges."""
+    an = xr.load_dataset(results / "fig4_history" / f"analysis_n{_sizes(results)[-1]}.nc")
+    assert yaml.safe_load(an.attrs["config_yaml"])["exact"]["simplex"] == "clp"
+    check_exact_ranges(an)
 
 
 def test_size_comparison_sees_a_shift_and_not_a_null(analysis):

@@ -35,7 +35,7 @@ def exact_ranges(cfg, ds, log=None):
     t0 = time.perf_counter()
     scene, c, H, F, mu = pile_problem(cfg, ds)
     nm = scene.n_mobile
-    es = ExactSet(H, F, mu)
+    es = ExactSet(H, F, mu, simplex=e["simplex"])
     specs, outer, slope = cut_specs(cfg, ds)
     C, _ = cm.cut_matrix(c, scene.pos, nm, specs)
     hist = (C @ np.column_stack([ds["force_n"].values, ds["force_t"].values]).ravel()).reshape(-1, 2)
