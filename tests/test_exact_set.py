@@ -131,3 +131,25 @@ def test_clp_simplex_reports_an_empty_polytope_and_a_bad_choice():
         ExactSet(H, 1e3 * np.abs(F) + 1.0, c.mu, simplex="clp").minimize(np.zeros(es.n))
     with pytest.raises(InputError, match="simplex = 'cplex'"):
         ExactSet(H, F, c.mu, simplex="cplex")
+
+
+def test_clp_model_refuses_arrays_of_the_wrong_length_before_clp_reads_them():
+    """CLP reads bounds, basis and a new row by the model's sizes: a shorter array is a
+    ValueError naming it, never a read past its end."""
+    import scipy.sparse as sp
+
+    from ncd.exact.clp_model import ClpModel
+    A = sp.csr_matrix(np.array([[1.0, 1.0, 0.0], [0.0, 1.0, 1.0]]))
+    one, zero = np.ones(2), np.zeros(3)
+    with pytest.raises(ValueError, match="col_hi has shape"):
+        ClpModel(A, one, one, zero, np.ones(2), 1e-10)
+    with pytest.raises(ValueError, match="row_lo has shape"):
+        ClpModel(A, np.ones(1), one, zero, np.ones(3), 1e-10)
+    m = ClpModel(A, one, one, zero, np.ones(3), 1e-10)
+    m.set_cost(np.array([1.0, 0.0, 1.0]))
+    assert m.run() == "optimal"
+    np.testing.assert_allclose(m.solution(), [0.0, 1.0, 0.0], atol=1e-12)
+    with pytest.raises(ValueError, match="w has shape"):
+        m.set_last_row(np.ones(2), 1.0, 1.0)
+    with pytest.raises(ValueError, match="basis of shape"):
+        m.set_basis(np.zeros(2, np.int8), np.zeros(2, np.int8))

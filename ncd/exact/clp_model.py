@@ -26,8 +26,13 @@ class ClpModel:
     primal and dual feasibility tolerances ``tol``; infinite bounds allowed."""
 
     def __init__(self, A, row_lo, row_hi, col_lo, col_hi, tol):
-        from cylp.cy import CyClpSimplex, CyCoinPackedMatrix
+        from cylp.cy import CyClpSimplex, CyCoinPackedMatrix  # on use: only simplex="clp" needs it
         A = sp.coo_matrix(A)
+        # CLP reads the bounds by the matrix's shape: a shorter array would be read past its end
+        for name, v, n in (("row_lo", row_lo, A.shape[0]), ("row_hi", row_hi, A.shape[0]),
+                           ("col_lo", col_lo, A.shape[1]), ("col_hi", col_hi, A.shape[1])):
+            if np.shape(v) != (n,):
+                raise ValueError(f"{name} has shape {np.shape(v)}; the matrix is {A.shape}")
         self.s = s = CyClpSimplex()
         big = s.getCoinInfinity()
 
@@ -39,7 +44,7 @@ class ClpModel:
         s.logLevel = 0
         s.primalTolerance = float(tol)
         s.dualTolerance = float(tol)
-        self.n_col, self.n_row, self.iterations = A.shape[1], A.shape[0], 0
+        self.n_col, self.n_row = A.shape[1], A.shape[0]
 
     def set_cost(self, c):
         self.s.setObjectiveArray(np.asarray(c, dtype=float))
@@ -47,9 +52,7 @@ class ClpModel:
     def run(self):
         """Primal simplex from the current basis; returns CLP's status ("optimal",
         "primal infeasible", ...)."""
-        status = self.s.primal()
-        self.iterations = int(self.s.iteration)
-        return str(status)
+        return str(self.s.primal())
 
     def solution(self):
         return np.asarray(self.s.primalVariableSolution, dtype=float)
@@ -68,6 +71,8 @@ class ClpModel:
 
     def set_last_row(self, w, lo, hi):
         """Replace the model's last row by ``lo <= w . x <= hi`` (``w`` dense, length n_col)."""
+        if np.shape(w) != (self.n_col,):
+            raise ValueError(f"w has shape {np.shape(w)} for a model of {self.n_col} columns")
         s = self.s
         s.CLP_deleteConstraints(np.array([self.n_row - 1], dtype=np.int32))
         idx = np.nonzero(w)[0].astype(np.int32)

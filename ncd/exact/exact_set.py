@@ -52,7 +52,7 @@ class ExactSet:
         self.highs, self.n_lp, self.lp_time = h, 0, 0.0
         self._cols = np.arange(self.n, dtype=np.int32)
         self._upper, self._cc, self._cc_support, self._last = upper, None, np.zeros(0, dtype=np.int64), None
-        self.simplex, self._clp, self._sector = simplex, None, (fp.A_eq, fp.b_eq)
+        self.simplex, self._clp = simplex, None
 
     def minimize(self, c):
         """``(min c . r, r)`` over A ∩ C (``c`` in force units, ``r`` forces)."""
@@ -80,8 +80,8 @@ class ExactSet:
             raise PolytopeError(f"LP not solved: {self.highs.modelStatusToString(status)}")
         if self.simplex == "clp":
             # the first LP's vertex becomes CLP's starting basis for every later LP
-            A_eq, b_eq = self._sector
-            self._clp = ClpModel(A_eq @ self.T, b_eq, b_eq, np.zeros(self.n), self._upper, FEAS_TOL)
+            fp = self.fp
+            self._clp = ClpModel(fp.A_eq @ self.T, fp.b_eq, fp.b_eq, np.zeros(self.n), self._upper, FEAS_TOL)
             self._clp.set_basis(*_basis_arrays(self.highs))
         r = self.T @ np.maximum(np.asarray(self.highs.getSolution().col_value), 0.0) * self.scale
         return float(np.dot(c, r)), r
@@ -277,9 +277,9 @@ class ExactSet:
             self.minimize(ca)
         row = np.append(w, 0.0)
         if self._cc is None:
-            A_eq, b_eq = self._sector
-            m = A_eq.shape[0]
-            A = sp.vstack([sp.hstack([A_eq @ self.T, -b_eq[:, None]]), sp.csr_matrix(row[None, :])])
+            fp = self.fp
+            m = fp.A_eq.shape[0]
+            A = sp.vstack([sp.hstack([fp.A_eq @ self.T, -fp.b_eq[:, None]]), sp.csr_matrix(row[None, :])])
             rhs = np.append(np.zeros(m), 1.0)
             self._cc = ClpModel(A, rhs, rhs, np.zeros(self.n + 1), np.append(self._upper, np.inf), FEAS_TOL)
         else:
