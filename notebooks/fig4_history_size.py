@@ -112,3 +112,13 @@ half-widths of {P['half_width'][0]:.0f} d and {P['half_width'][-1]:.0f} d (cone 
 **Limits.** The large size has only {piles[-1]} piles per history: its bands are wide, and a change smaller than them is not resolved. A claim about
 size rests on these bands, not on one pile.
 """))
+
+# %% [markdown]
+# **Exact ranges against size.** For the first piles of each history at each size
+# (`exact.piles`), the range over A ∩ C of the angle of the resultant across every cut: two
+# linear-fractional programs per cut, each end certified by a Dinkelbach LP (the exact sets
+# of the history page; the piles of 10⁴ grains by CLP's simplex). The history forces give one
+# admissible angle, which must lie in the range.
+
+# %%
+display(Markdown(hs.exact_text(sz)))

@@ -379,6 +379,42 @@ def test_the_largest_piles_exact_ranges_by_clp_hold_the_history_angle(size, resu
     check_exact_ranges(an)
 
 
+def test_size_study_states_each_sizes_exact_ranges(size, results):
+    """size.nc carries, per size and history, the exact ranges of the piles that have them,
+    recomputed here from each analysis; the page's sentence states them."""
+    from ncd.figures import history_size as hsz
+
+    text = hsz.exact_text(size)
+    for z, n in enumerate(_sizes(results)):
+        an = xr.load_dataset(results / "fig4_history" / f"analysis_n{n}.nc")
+        cfg = yaml.safe_load(an.attrs["config_yaml"])
+        for i, h in enumerate(size.history.values):
+            x = size.isel(size=z, history=i)
+            piles = min(cfg["exact"]["piles"], cfg["piles"])
+            assert int(x.exact_piles) == piles
+            e = an.sel(history=h).isel(pile=slice(0, piles))
+            width = (e.exact_deviation_max - e.exact_deviation_min).values
+            ok = np.isfinite(width)
+            assert int(x.exact_cuts) == ok.sum() and 0 < ok.sum() <= width.size
+            assert float(x.exact_width_median) == pytest.approx(np.median(width[ok]), abs=1e-12)
+            assert float(x.exact_width_max) == pytest.approx(width[ok].max(), abs=1e-12)
+            assert float(x.exact_confirmed) == pytest.approx(ok.mean(), abs=1e-12)   # every range certified
+            assert 0 <= float(x.exact_outside_max) < 1e-5
+            assert f"{n} grains, {h}, {piles} pile(s): {ok.sum()} of {width.size} cuts have an angle range" in text
+            assert f"{ok.sum()} certified to 1e-6°" in text
+
+
+def test_size_study_without_exact_ranges_says_so(analysis):
+    from ncd.figures import history_size as hsz
+
+    bare = analysis.drop_vars([v for v in analysis.data_vars if v.startswith("exact_")])
+    sz = hsz.size_dataset([analysis, bare.assign(n_grains=bare.n_grains * 10)])
+    assert np.all(sz.exact_piles.values[1] == 0) and np.isnan(sz.exact_width_median.values[1]).all()
+    assert np.all(sz.exact_piles.values[0] > 0)
+    n = int(sz.grains.values[1])
+    assert f"{n} grains, point: no exact ranges computed." in hsz.exact_text(sz)
+
+
 def test_size_comparison_sees_a_shift_and_not_a_null(analysis):
     """Two copies of one analysis: no change (p = 1); a copy with every cut deviation 5° larger
     and ten times the grains: an arching change of exactly 5° and an unchanged dip."""

@@ -8,6 +8,8 @@ lying outside their own bootstrap band (the page says why).
 import matplotlib.pyplot as plt
 import numpy as np
 
+from ncd.figures.history_analysis import exact_summary
+
 COLORS = {"point": "C3", "rain": "C0"}
 LABELS = {"point": "point source", "rain": "rain"}
 
@@ -162,15 +164,7 @@ def summary(an):
         out[h].update(grains=float(an.n_grains.sel(history=h).mean()),
                       grains_min=int(an.n_grains.sel(history=h).min()), grains_max=int(an.n_grains.sel(history=h).max()),
                       removed=float(an.n_removed.sel(history=h).mean()))
-        if "exact_computed" in an and int(an.exact_computed.sel(history=h).sum()):
-            e = an.sel(history=h).where(an.exact_computed.sel(history=h) == 1, drop=True)
-            width = (e.exact_deviation_max - e.exact_deviation_min).values
-            out[h].update(exact_piles=int(e.sizes["pile"]), exact_width_median=float(np.nanmedian(width)),
-                          exact_width_max=float(np.nanmax(width)),
-                          exact_all_positive=float(np.mean(e.exact_deviation_min.values > 0)),
-                          exact_all_negative=float(np.mean(e.exact_deviation_max.values < 0)),
-                          exact_undefined=float(np.mean(np.isnan(width))),
-                          exact_confirmed=float(e.exact_confirmed.mean()) if "exact_confirmed" in e else np.nan)
+        out[h].update(exact_summary(an, h) or {})
     out["diff"] = float(an.dip_diff.sel(kernel=k0))
     out["diff_lo"], out["diff_hi"] = float(an.dip_diff_lo.sel(kernel=k0)), float(an.dip_diff_hi.sel(kernel=k0))
     out["p"] = {float(k): float(an.dip_diff_p.sel(kernel=k)) for k in an.kernel.values}
