@@ -10,8 +10,8 @@ base half-width, so profiles of every size compare directly.
 import numpy as np
 import xarray as xr
 
-from ncd.figures.history_analysis import EXACT_SUMMARY, bootstrap_index, exact_summary, permutation_p
-from ncd.figures.history_plots import COLORS
+from ncd.figures.history_analysis import bootstrap_index, permutation_p
+from ncd.figures.history_plots import COLORS, EXACT_SUMMARY, exact_summary
 
 
 def _pile_arching(an):
@@ -71,7 +71,7 @@ def size_dataset(analyses, seed=16):
                 dip_p[s, i, j] = permutation_p(float(ref.dip_mean.values[i, j]), float(an.dip_mean.values[i, j]),
                                                pa, pb, ref.xi.values, a["dip_center"], np.asarray(a["dip_flank"]),
                                                rng, int(a["permutations"]))
-    # the exact angle ranges of each size's first piles (history_analysis.exact_summary; NaN: none)
+    # the exact angle ranges of each size's first piles (history_plots.exact_summary; NaN: none)
     exact = {k: np.full((S, H), np.nan) for k in EXACT_SUMMARY}
     for s, an in enumerate(ans):
         for i, h in enumerate(hist):
