@@ -400,7 +400,8 @@ def test_size_study_states_each_sizes_exact_ranges(size, results):
             assert float(x.exact_width_max) == pytest.approx(width[ok].max(), abs=1e-12)
             assert float(x.exact_confirmed) == pytest.approx(ok.mean(), abs=1e-12)   # every range certified
             assert 0 <= float(x.exact_outside_max) < 1e-5
-            assert f"{n} grains, {h}, {piles} pile(s): {ok.sum()} of {width.size} cuts have an angle range" in text
+            grains = int(size.grains.values[z])         # the mean over piles, as the page names the size
+            assert f"{grains} grains, {h}, {piles} pile(s): {ok.sum()} of {width.size} cuts have an angle range" in text
             assert f"{ok.sum()} certified to 1e-6°" in text
 
 

@@ -40,7 +40,7 @@ def exact_summary(an, history):
                 exact_all_positive=float(np.mean(e.exact_deviation_min.values > 0)),
                 exact_all_negative=float(np.mean(e.exact_deviation_max.values < 0)),
                 exact_undefined=float(np.mean(np.isnan(width))),
-                exact_confirmed=float(e.exact_confirmed.mean()) if "exact_confirmed" in e else np.nan,
+                exact_confirmed=float(np.mean(e.exact_confirmed.values, dtype=float)) if "exact_confirmed" in e else np.nan,
                 exact_outside_max=_nanmax(e.exact_history_outside.values))
 
 
