@@ -45,7 +45,9 @@
 # * `rules.nc`: the wall time of every rule of the figures' run, from Snakemake's
 #   `benchmark:` files;
 # * `dag.nc`: the CPU time of every job of the default run and the critical path of its
-#   DAG (the job graph of a dry run, the times of the benchmark files).
+#   DAG (the job graph of a dry run, the times of the benchmark files);
+# * `exact_sets.nc`: the LPs and LP time of the exact angle ranges of every history pile
+#   with an exact file (`ncd.studies.bench.exact_costs`), the size study's included.
 
 # %%
 import matplotlib
@@ -58,7 +60,7 @@ from ncd.studies import bench_page as page
 matplotlib.use("Agg")  # the figure is shown once, as the saved PNG
 
 # Snakemake's object, or by hand (from the repository or notebooks/) the files under results/
-NAMES = ["core", "sweeps", "tolerance", "tolerance_problems", "ensemble", "peer", "rules", "dag"]
+NAMES = ["core", "sweeps", "tolerance", "tolerance_problems", "ensemble", "peer", "rules", "dag", "exact_sets"]
 snakemake = paths("bench", NAMES, globals().get("snakemake"))
 data = {name: xr.load_dataset(getattr(snakemake.input, name)) for name in NAMES}
 core, sweeps, tol_ds, tol_pb = data["core"], data["sweeps"], data["tolerance"], data["tolerance_problems"]
@@ -189,3 +191,16 @@ display(Markdown(page.rules_sentence(data["rules"])))
 # %%
 per_fig, path, text = page.dag_tables(data["dag"])
 display(HTML(per_fig), HTML(path), Markdown(text))
+
+# %% [markdown]
+# ## Exact sets of the history piles
+#
+# The exact angle ranges over A ∩ C at the 18 cuts of a pile of `fig4_history`
+# (`ncd.figures.history_exact`: per cut, min p, two Charnes–Cooper LPs and their Dinkelbach
+# certificates, and the largest vertical component), from the exact files of the run: the
+# LPs, the simplex that restarts them from the previous basis (HiGHS in the default run, CLP
+# for the piles of 10⁴ grains) and their wall time (one thread). The piles of 10⁴ grains
+# appear once the size study (`snakemake -j2 fig4_history_size`) has run.
+
+# %%
+display(HTML(page.table(page.exact_frame(data["exact_sets"]))), Markdown(page.exact_sentence(data["exact_sets"])))

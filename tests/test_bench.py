@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
+import yaml
 
 import ncd
 from ncd.dynamics.explore import explore, run_parallel
@@ -81,6 +82,26 @@ def test_rule_times_reads_snakemake_benchmark_files(tmp_path):
     assert list(ds.figure.values) == ["fig9", "fig9"]
     np.testing.assert_allclose(ds.seconds, [3.0, 12.5])
     assert np.isnan(ds.max_rss_mb[0]) and ds.max_rss_mb[1] == 250.5
+
+
+def _exact_file(path, history, member, contacts, n_lp, seconds, simplex):
+    path.parent.mkdir(parents=True, exist_ok=True)
+    xr.Dataset({"n_lp": (("flank", "cut_position"), np.asarray(n_lp).reshape(2, -1))},
+               attrs={"history": history, "member": member, "n_contacts": contacts, "lp_wall_time": seconds,
+                      "config_yaml": yaml.safe_dump({"exact": {"simplex": simplex}})}).to_netcdf(path)
+
+
+def test_exact_costs_reads_every_piles_exact_file(tmp_path):
+    """One row per exact file, the size from its directory, the LPs summed over its cuts."""
+    e = tmp_path / "fig4_history" / "exact"
+    _exact_file(e / "n10000" / "rain_000.nc", "rain", 0, 14378, [6] * 18, 480.2, "clp")
+    _exact_file(e / "n1000" / "point_001.nc", "point", 1, 1702, [7, 6, 6, 6], 3.5, "highs")
+    ds = bench.exact_costs(list(e.glob("n*/*.nc")))
+    assert list(ds.grains.values) == [1000, 10000] and list(ds.history.values) == ["point", "rain"]
+    assert list(ds.member.values) == [1, 0] and list(ds.n_contacts.values) == [1702, 14378]
+    assert list(ds.n_cuts.values) == [4, 18] and list(ds.n_lp.values) == [25, 108]
+    assert list(ds.simplex.values) == ["highs", "clp"]
+    np.testing.assert_array_equal(ds.lp_seconds.values, [3.5, 480.2])
 
 
 DRY_RUN = """Building DAG of jobs...
@@ -192,7 +213,8 @@ def bench_results(results):
     d = results / "bench"
     if not (d / "core.nc").exists():
         pytest.skip(f"no benchmark results in {d} (run `snakemake -j2 bench`)")
-    return {k: xr.load_dataset(d / f"{k}.nc") for k in ("core", "sweeps", "ensemble", "peer", "rules", "dag")}
+    return {k: xr.load_dataset(d / f"{k}.nc") for k in ("core", "sweeps", "ensemble", "peer", "rules", "dag",
+                                                         "exact_sets")}
 
 
 def test_bench_core_data(bench_results):
@@ -220,6 +242,19 @@ def test_bench_rules_cover_every_figure(bench_results):
         names = set(rules.rule.values[rules.figure.values == fig])
         assert any(n.endswith("notebook") for n in names), (fig, names)
     assert (rules.seconds > 0).all()
+
+
+def test_bench_exact_sets_cover_every_exact_file(bench_results, results):
+    """exact_sets.nc: a row per exact file of fig4_history, its LP count and time those the file records."""
+    costs = bench_results["exact_sets"]
+    files = sorted((results / "fig4_history" / "exact").glob("n*/*.nc"))
+    assert costs.sizes["pile"] == len(files) > 0
+    for k, f in enumerate(files):
+        e = xr.load_dataset(f)
+        row = costs.isel(pile=k)
+        assert int(row.grains) == int(f.parent.name[1:]) and str(row.history.values) == e.attrs["history"]
+        assert int(row.n_lp) == int(e.n_lp.sum()) and int(row.n_contacts) == int(e.attrs["n_contacts"])
+        assert float(row.lp_seconds) == float(e.attrs["lp_wall_time"]) > 0
 
 
 def test_tolerance_table_both_methods_reach_the_tolerance():

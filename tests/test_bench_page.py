@@ -160,6 +160,30 @@ def test_rules_and_dag_tables():
     assert "Critical path 70 s through 3 jobs" in text and path.count("<tr>") == 3      # one row per job of the path
 
 
+def small_exact(sizes=(1000, 10000)):
+    """Two piles per history at 10^3 grains (LP seconds 2, 4 and 1, 3) and one at 10^4 (600, 300)."""
+    rows = [(1000, "point", 2.0), (1000, "point", 4.0), (1000, "rain", 1.0), (1000, "rain", 3.0),
+            (10000, "point", 600.0), (10000, "rain", 300.0)]
+    rows = [r for r in rows if r[0] in sizes]
+    col = lambda i: [r[i] for r in rows]                     # noqa: E731
+    return xr.Dataset({"grains": ("pile", col(0)), "history": ("pile", col(1)), "member": ("pile", [0] * len(rows)),
+                       "n_contacts": ("pile", [1700 if g == 1000 else 17000 for g in col(0)]),
+                       "n_cuts": ("pile", [18] * len(rows)), "n_lp": ("pile", [110] * len(rows)),
+                       "simplex": ("pile", ["highs" if g == 1000 else "clp" for g in col(0)]),
+                       "lp_seconds": ("pile", col(2))})
+
+
+def test_exact_sets_table_and_sentence():
+    frame = BP.exact_frame(small_exact())
+    assert list(frame["piles"]) == [2, 2, 1, 1] and list(frame["simplex"]) == ["highs", "highs", "clp", "clp"]
+    np.testing.assert_array_equal(frame["LP seconds per pile (median)"], [3.0, 2.0, 600.0, 300.0])
+    np.testing.assert_array_equal(frame["LP seconds per pile (largest)"], [4.0, 3.0, 600.0, 300.0])
+    text = BP.exact_sentence(small_exact())
+    assert "point 3 s (largest 4 s, 2 piles), rain 2 s (largest 3 s, 2 piles) at 1000 grains" in text
+    assert "point 600 s (1 pile), rain 300 s (1 pile) at 10000 grains." in text and "size study" not in text
+    assert "the size study" in BP.exact_sentence(small_exact((1000,)))
+
+
 def test_bench_figure_is_readable():
     fig = BP.plot(small_core(), small_sweeps(), small_rules())
     assert problems(fig) == []

@@ -224,6 +224,37 @@ def dag_tables(dag):
     return table(per_fig, digits=4), table(path, digits=4, index=False), text
 
 
+def exact_frame(costs):
+    """Per size and history: piles, contacts, LPs per pile, the simplex, and the LP time per
+    pile (median and largest) of the exact angle ranges (:func:`ncd.studies.bench.exact_costs`)."""
+    df = costs.to_dataframe()
+    g = df.groupby(["grains", "history"])
+    return pd.DataFrame({"piles": g.size(), "contacts (mean)": g.n_contacts.mean().round().astype(int),
+                         "cuts per pile": g.n_cuts.max(), "LPs per pile (mean)": g.n_lp.mean(),
+                         "simplex": g.simplex.agg(lambda v: ", ".join(sorted(set(v)))),
+                         "LP seconds per pile (median)": g.lp_seconds.median(),
+                         "LP seconds per pile (largest)": g.lp_seconds.max()})
+
+
+def exact_sentence(costs):
+    """The LP time of one pile's exact angle ranges at each size computed, in one sentence."""
+    frame = exact_frame(costs).reset_index()
+    sizes = sorted(set(frame.grains))
+    def pile(r):
+        if r["piles"] == 1:
+            return f"{r['history']} {number(r['LP seconds per pile (median)'], 2)} s (1 pile)"
+        return (f"{r['history']} {number(r['LP seconds per pile (median)'], 2)} s (largest "
+                f"{number(r['LP seconds per pile (largest)'], 2)} s, {r['piles']} piles)")
+
+    parts = [", ".join(pile(r) for _, r in frame[frame.grains == n].iterrows()) + f" at {int(n)} grains"
+             for n in sizes]
+    text = "The exact angle ranges of one pile take, in LP time per pile (median): " + "; ".join(parts) + "."
+    if len(sizes) < 2:
+        text += (" No pile of another size has exact ranges in this run: the size study "
+                 "(`snakemake -j2 fig4_history_size`, `config/large.yaml`: 10^4 grains) adds them.")
+    return text
+
+
 def _legend_below(ax, ncol=1):
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=ncol, frameon=False, fontsize=9)
 

@@ -132,6 +132,25 @@ rule bench_rules:
         "../scripts/bench_rules.py"
 
 
+rule bench_exact:
+    """The LP time of the exact angle ranges of every pile of fig4_history (its exact files,
+    and those of the size study when it has run)."""
+    input:
+        figure_targets("fig4_history"),
+    output:
+        "results/bench/exact_sets.nc",
+    params:
+        pattern="results/fig4_history/exact/n*/*.nc",
+    log:
+        log(FIGB, "exact"),
+    benchmark:
+        bench(FIGB, "exact")
+    conda:
+        CONDA_ENV
+    script:
+        "../scripts/bench_exact.py"
+
+
 rule bench_dag:
     """CPU seconds of every job of the default run and the critical path of its DAG
     (the job graph from a dry run, the times from the benchmark files)."""
@@ -163,6 +182,7 @@ rule bench_notebook:
         peer="results/bench/peer.nc",
         rules="results/bench/rules.nc",
         dag="results/bench/dag.nc",
+        exact_sets="results/bench/exact_sets.nc",
         notebook=notebook_file("bench"),
         notebook_py=notebook_file("bench", "py"),
         page=page_modules(FIGB),
