@@ -408,11 +408,13 @@ def exact_costs(paths):
     col = lambda i: np.array([r[i] for r in rows])                        # noqa: E731
     one = lambda i, u, ln: ("pile", col(i), {"units": u, "long_name": ln})  # noqa: E731
     return xr.Dataset({"grains": one(0, "1", "grains of the pile's size (the n of its directory)"),
-                       "history": ("pile", col(1).astype(str)), "member": one(2, "1", "pile member"),
+                       "history": ("pile", col(1).astype(str), {"units": "1", "long_name": "construction history"}),
+                       "member": one(2, "1", "pile member"),
                        "n_contacts": one(3, "1", "contacts of the pile's final state"),
                        "n_cuts": one(4, "1", "cuts with an angle range computed"),
                        "n_lp": one(5, "1", "linear programs of the pile"),
-                       "simplex": ("pile", col(6).astype(str)),
+                       "simplex": ("pile", col(6).astype(str), {"units": "1", "long_name":
+                                   "simplex that restarted the LPs from the previous basis (highs or clp)"}),
                        "lp_seconds": one(7, "s", "wall time of the pile's LPs (single-threaded)")},
                       coords={"pile": np.arange(len(rows))})
 
