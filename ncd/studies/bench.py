@@ -627,6 +627,14 @@ def speed_rows(results):
                 row(f"{label}, to {tight:.0e}: plain NLGS / local exact solves",
                     f"{_sig(t.sel(solver='nlgs'))} / {_sig(t.sel(solver='nlgs+local'))}", "s",
                     "tolerance_problems.nc")
+    if (bench_dir / "exact_sets.nc").exists():
+        ex = xr.load_dataset(bench_dir / "exact_sets.nc")
+        for h in sorted(set(ex.history.values)):
+            e = ex.where(ex.history == h, drop=True)
+            sizes = sorted({int(n) for n in e.grains.values})
+            med = [float(np.median(e.lp_seconds.values[e.grains.values == n])) for n in sizes]
+            row(f"exact angle ranges of one {h} pile, N = {' / '.join(map(str, sizes))}: LP time (median)",
+                " / ".join(_sig(m, 2) for m in med), "s", "exact_sets.nc")
     if (bench_dir / "peer.nc").exists():
         peer = xr.load_dataset(bench_dir / "peer.nc")
         row("poured pile, median step: ncd / pymunk", f"{_sig(peer.time_median.sel(engine='ncd') * 1e3)} / "
