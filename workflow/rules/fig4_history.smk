@@ -217,7 +217,8 @@ rule fig4_history_size_notebook:
 
 
 rule fig4_history_size:
-    """The size study: piles of every size, their analyses and the comparison page (about an
-    hour of CPU with config/large.yaml's four piles of 10^4 grains per history)."""
+    """The size study: piles of every size, their analyses and the comparison page (with
+    config/large.yaml's four piles of 10^4 grains per history, about 75 min of CPU and 45 min
+    on two cores; the bench page gives the exact sets' share)."""
     input:
         figure_targets(FHS),
