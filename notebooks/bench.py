@@ -195,7 +195,7 @@ display(HTML(per_fig), HTML(path), Markdown(text))
 # %% [markdown]
 # ## Exact sets of the history piles
 #
-# The exact angle ranges over A ∩ C at the 18 cuts of a pile of `fig4_history`
+# The exact angle ranges over A ∩ C at the cuts of a pile of `fig4_history`
 # (`ncd.figures.history_exact`: per cut, min p, two Charnes–Cooper LPs and their Dinkelbach
 # certificates, and the largest vertical component), from the exact files of the run: the
 # LPs, the simplex that restarts them from the previous basis (HiGHS in the default run, CLP

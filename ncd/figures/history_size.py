@@ -200,7 +200,7 @@ def exact_text(sz):
     per_pile = sz.sizes["flank"] * sz.sizes["cut_position"]
     parts = []
     for z, n in enumerate(s["grains"]):
-        for h in ("point", "rain"):
+        for h in sz.history.values:
             x = {k: v[z] for k, v in s[h].items() if k in EXACT_SUMMARY}
             if not x.get("exact_piles"):
                 parts.append(f"{n} grains, {h}: no exact ranges computed.")

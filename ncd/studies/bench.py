@@ -411,7 +411,7 @@ def exact_costs(paths):
                        "history": ("pile", col(1).astype(str), {"units": "1", "long_name": "construction history"}),
                        "member": one(2, "1", "pile member"),
                        "n_contacts": one(3, "1", "contacts of the pile's final state"),
-                       "n_cuts": one(4, "1", "cuts with an angle range computed"),
+                       "n_cuts": one(4, "1", "cuts of the pile (an angle range sought at each)"),
                        "n_lp": one(5, "1", "linear programs of the pile"),
                        "simplex": ("pile", col(6).astype(str), {"units": "1", "long_name":
                                    "simplex that restarted the LPs from the previous basis (highs or clp)"}),
