@@ -196,11 +196,12 @@ display(HTML(per_fig), HTML(path), Markdown(text))
 # ## Exact sets of the history piles
 #
 # The exact angle ranges over A ∩ C at the cuts of a pile of `fig4_history`
-# (`ncd.figures.history_exact`: per cut, min p, two Charnes–Cooper LPs and their Dinkelbach
+# (`ncd.figures.history_exact`: per cut, min p, two Charnes–Cooper LPs with their
 # certificates, and the largest vertical component), from the exact files of the run: the
-# LPs, the simplex that restarts them from the previous basis (HiGHS in the default run, CLP
-# for the piles of 10⁴ grains) and their wall time (one thread). The piles of 10⁴ grains
-# appear once the size study (`snakemake -j2 fig4_history_size`) has run.
+# LPs, the solver (in the default run HiGHS's simplex, restarted from the previous basis, a
+# Dinkelbach LP certifying each end; for the piles of 10⁴ grains Clarabel's interior point,
+# each end certified by its LP's dual) and their wall time (one thread). The piles of 10⁴
+# grains appear once the size study (`snakemake -j2 fig4_history_size`) has run.
 
 # %%
 display(HTML(page.table(page.exact_frame(data["exact_sets"]))), Markdown(page.exact_sentence(data["exact_sets"])))

@@ -116,9 +116,10 @@ size rests on these bands, not on one pile.
 # %% [markdown]
 # **Exact ranges against size.** For the first piles of each history at each size
 # (`exact.piles`), the range over A ∩ C of the angle of the resultant across every cut: two
-# linear-fractional programs per cut, each end certified by a Dinkelbach LP (the exact sets
-# of the history page; the piles of 10⁴ grains by CLP's simplex). The history forces give one
-# admissible angle, which must lie in the range.
+# linear-fractional programs per cut, each end certified (the exact sets of the history page:
+# a Dinkelbach LP after HiGHS's simplex; the piles of 10⁴ grains by Clarabel's interior point,
+# each end bounded by its LP's dual). The history forces give one admissible angle, which must
+# lie in the range.
 
 # %%
 display(Markdown(hs.exact_text(sz)))

@@ -84,23 +84,23 @@ def test_rule_times_reads_snakemake_benchmark_files(tmp_path):
     assert np.isnan(ds.max_rss_mb[0]) and ds.max_rss_mb[1] == 250.5
 
 
-def _exact_file(path, history, member, contacts, n_lp, seconds, simplex):
+def _exact_file(path, history, member, contacts, n_lp, seconds, solver):
     path.parent.mkdir(parents=True, exist_ok=True)
     xr.Dataset({"n_lp": (("flank", "cut_position"), np.asarray(n_lp).reshape(2, -1))},
                attrs={"history": history, "member": member, "n_contacts": contacts, "lp_wall_time": seconds,
-                      "config_yaml": yaml.safe_dump({"exact": {"simplex": simplex}})}).to_netcdf(path)
+                      "config_yaml": yaml.safe_dump({"exact": {"solver": solver}})}).to_netcdf(path)
 
 
 def test_exact_costs_reads_every_piles_exact_file(tmp_path):
     """One row per exact file, the size from its directory, the LPs summed over its cuts."""
     e = tmp_path / "fig4_history" / "exact"
-    _exact_file(e / "n10000" / "rain_000.nc", "rain", 0, 14378, [6] * 18, 480.2, "clp")
+    _exact_file(e / "n10000" / "rain_000.nc", "rain", 0, 14378, [6] * 18, 480.2, "clarabel")
     _exact_file(e / "n1000" / "point_001.nc", "point", 1, 1702, [7, 6, 6, 6], 3.5, "highs")
     ds = bench.exact_costs(list(e.glob("n*/*.nc")))
     assert list(ds.grains.values) == [1000, 10000] and list(ds.history.values) == ["point", "rain"]
     assert list(ds.member.values) == [1, 0] and list(ds.n_contacts.values) == [1702, 14378]
     assert list(ds.n_cuts.values) == [4, 18] and list(ds.n_lp.values) == [25, 108]
-    assert list(ds.simplex.values) == ["highs", "clp"]
+    assert list(ds.solver.values) == ["highs", "clarabel"]
     np.testing.assert_array_equal(ds.lp_seconds.values, [3.5, 480.2])
 
 

@@ -169,13 +169,13 @@ def small_exact(sizes=(1000, 10000)):
     return xr.Dataset({"grains": ("pile", col(0)), "history": ("pile", col(1)), "member": ("pile", [0] * len(rows)),
                        "n_contacts": ("pile", [1700 if g == 1000 else 17000 for g in col(0)]),
                        "n_cuts": ("pile", [18] * len(rows)), "n_lp": ("pile", [110] * len(rows)),
-                       "simplex": ("pile", ["highs" if g == 1000 else "clp" for g in col(0)]),
+                       "solver": ("pile", ["highs" if g == 1000 else "clarabel" for g in col(0)]),
                        "lp_seconds": ("pile", col(2))})
 
 
 def test_exact_sets_table_and_sentence():
     frame = BP.exact_frame(small_exact())
-    assert list(frame["piles"]) == [2, 2, 1, 1] and list(frame["simplex"]) == ["highs", "highs", "clp", "clp"]
+    assert list(frame["piles"]) == [2, 2, 1, 1] and list(frame["solver"]) == ["highs", "highs", "clarabel", "clarabel"]
     np.testing.assert_array_equal(frame["LP seconds per pile (median)"], [3.0, 2.0, 600.0, 300.0])
     np.testing.assert_array_equal(frame["LP seconds per pile (largest)"], [4.0, 3.0, 600.0, 300.0])
     text = BP.exact_sentence(small_exact())

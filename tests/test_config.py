@@ -98,7 +98,7 @@ def test_a_config_that_slipped_through_is_refused_naming_the_key(overlay, messag
     ("fig2_slope: {flow: {step: 101}}", "fig2_slope.flow.step = 101 must be <= fig2_slope.flow.n_steps = 100"),
     ("fig3_equilibrium: {modes: {zero: {runs: 1.0e+4}}}", "fig3_equilibrium.modes.zero.runs = 10000.0"),
     ("fig3_equilibrium: {solver: {max_sweeps: 20000.5}}", "fig3_equilibrium.solver.max_sweeps = 20000.5"),
-    ("fig4_history: {exact: {simplex: cplex}}", "fig4_history.exact.simplex = 'cplex'"),
+    ("fig4_history: {exact: {solver: cplex}}", "fig4_history.exact.solver = 'cplex'"),
 ])
 def test_nonfinite_cross_field_and_integer_checks_everywhere(overlay, message):
     text = errors_of(overlay)

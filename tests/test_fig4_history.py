@@ -279,7 +279,7 @@ def check_exact_ranges(analysis):
     # degrees; the history forces balance the weights to the equilibrium test's accuracy only,
     # which a small resultant near a toe turns into ~1e-6 degree (measured 1.2e-6 on the reduced piles)
     assert float(np.nanmax(e.exact_history_outside.values)) < 1e-5
-    # every finite range is certified (Dinkelbach's error bound <= 1e-6 degree)
+    # every finite range is certified (its error bound <= CERTIFIED_DEG: Dinkelbach's, or the dual's)
     np.testing.assert_array_equal(e.exact_confirmed.values.astype(bool), ok)
 
 
@@ -371,11 +371,11 @@ def test_size_study_compares_every_size(size, results):
     assert np.isnan(p[0]).all() and np.all((p[1:] > 0) & (p[1:] <= 1))
 
 
-def test_the_largest_piles_exact_ranges_by_clp_hold_the_history_angle(size, results):
-    """The size overlay's exact ranges come from CLP's simplex (as config/large.yaml's): the
-    same checks as the default piles' HiGHS ranges."""
+def test_the_largest_piles_exact_ranges_by_interior_point_hold_the_history_angle(size, results):
+    """The size overlay's exact ranges come from Clarabel's interior point (as
+    config/large.yaml's): the same checks as the default piles' HiGHS ranges."""
     an = xr.load_dataset(results / "fig4_history" / f"analysis_n{_sizes(results)[-1]}.nc")
-    assert yaml.safe_load(an.attrs["config_yaml"])["exact"]["simplex"] == "clp"
+    assert yaml.safe_load(an.attrs["config_yaml"])["exact"]["solver"] == "clarabel"
     check_exact_ranges(an)
 
 
@@ -402,7 +402,7 @@ def test_size_study_states_each_sizes_exact_ranges(size, results):
             assert 0 <= float(x.exact_outside_max) < 1e-5
             grains = int(size.grains.values[z])         # the mean over piles, as the page names the size
             assert f"{grains} grains, {h}, {piles} pile(s): {ok.sum()} of {width.size} cuts have an angle range" in text
-            assert f"{ok.sum()} certified to 1e-6°" in text
+            assert f"{ok.sum()} certified to {ha.CERTIFIED_DEG:g}°" in text
 
 
 def test_size_study_without_exact_ranges_says_so(analysis):

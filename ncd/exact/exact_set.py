@@ -117,7 +117,7 @@ class ExactSet:
         act = (G @ x) >= -active_tol
         K = sp.vstack([A, G[np.nonzero(act)[0]]]).tocsr()
         rhs = np.concatenate([self.fp.b_eq, np.zeros(int(act.sum()))])
-        return (x + _min_norm(K, rhs - K @ x)) * self.scale
+        return (x + min_norm_correction(K, rhs - K @ x)) * self.scale
 
     def intervals(self, rows):
         """Exact ``(min, max)`` of each row of a sparse matrix over A ∩ C, shape (m, 2).
@@ -398,7 +398,7 @@ def sector_model(A_eq, b_eq, T, upper, **options):
     return h
 
 
-def _min_norm(K, r, eps=1e-12, refine=20):
+def min_norm_correction(K, r, eps=1e-12, refine=20):
     """Minimum-norm ``d`` with ``K d = r`` (K: p x n sparse, consistent)."""
     from scipy.sparse.linalg import splu
     p, n = K.shape

@@ -3,8 +3,11 @@
 Over ``A ∩ C`` of one pile's final configuration (:class:`ncd.exact.exact_set.ExactSet`),
 the exact range of the angle of the resultant across each cut of
 :func:`ncd.figures.history_analysis.pile_measures`: a linear-fractional program, solved
-by the Charnes-Cooper LP with a certified error bound (a Dinkelbach LP).  The history forces' angle must
-lie in that range (``history_outside`` counts the exceptions).
+by the Charnes-Cooper LP with a certified error bound.  ``exact.solver`` picks the route: vertices
+by simplex restarts (:class:`ExactSet`, HiGHS or CLP; the bound from a Dinkelbach LP) or an
+interior point with bounds from the dual (:class:`InteriorSet`, Clarabel: the piles of 10^4
+grains).  The history forces' angle must lie in that range (``history_outside`` counts the
+exceptions).
 """
 import time
 
@@ -12,6 +15,7 @@ import numpy as np
 import xarray as xr
 
 from ncd.exact.exact_set import ExactSet
+from ncd.exact.interior_set import InteriorSet
 from ncd.figures.history_analysis import norm_length
 from ncd.scenes import cuts as cm
 from ncd.scenes.pile import pile_problem
@@ -35,7 +39,7 @@ def exact_ranges(cfg, ds, log=None):
     t0 = time.perf_counter()
     scene, c, H, F, mu = pile_problem(cfg, ds)
     nm = scene.n_mobile
-    es = ExactSet(H, F, mu, simplex=e["simplex"])
+    es = InteriorSet(H, F, mu) if e["solver"] == "clarabel" else ExactSet(H, F, mu, simplex=e["solver"])
     specs, outer, slope = cut_specs(cfg, ds)
     C, _ = cm.cut_matrix(c, scene.pos, nm, specs)
     hist = (C @ np.column_stack([ds["force_n"].values, ds["force_t"].values]).ravel()).reshape(-1, 2)

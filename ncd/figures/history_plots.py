@@ -314,7 +314,7 @@ def exact_text(an):
                      f"admissible state is steeper than the flank at {100 * x['exact_all_positive']:.0f} % of the cuts "
                      f"and every one shallower at {100 * x['exact_all_negative']:.0f} %; at "
                      f"{100 * x['exact_undefined']:.0f} % the admissible resultants surround zero (no angle range); the "
-                     "ranges are exact (a linear-fractional program per end, each certified to 1e-6° at "
+                     f"ranges are exact (a linear-fractional program per end, each certified to {CERTIFIED_DEG:g}° at "
                      f"{100 * x['exact_confirmed']:.0f} % of the cuts).")
     return (" ".join(parts) + " The arching angle of one force state is thus one choice among many: the spread of "
             "the history angles over piles is to be read against these ranges.")

@@ -395,8 +395,8 @@ def rule_times(paths):
 def exact_costs(paths):
     """The cost of the exact angle ranges of every pile with an exact file
     ``.../exact/n<N>/<history>_<member>.nc`` (:mod:`ncd.figures.history_exact`), as a Dataset
-    over ``pile``: the grains of its size, contacts, cuts, LPs, the simplex that restarted them
-    and the wall time of the LPs (single-threaded solvers, so about their CPU time on an
+    over ``pile``: the grains of its size, contacts, cuts, LPs, the LP solver (config
+    ``exact.solver``) and the wall time of the LPs (single-threaded solvers, so about their CPU time on an
     unloaded core).  Piles of the size study appear when it has run."""
     rows = []
     for p in sorted(Path(x) for x in paths):
@@ -404,7 +404,7 @@ def exact_costs(paths):
             cfg = yaml.safe_load(e.attrs["config_yaml"]) if "config_yaml" in e.attrs else {}
             rows.append((int(p.parent.name.lstrip("n")), str(e.attrs["history"]), int(e.attrs["member"]),
                          int(e.attrs["n_contacts"]), int(e.n_lp.size), int(e.n_lp.sum()),
-                         str(cfg.get("exact", {}).get("simplex", "highs")), float(e.attrs["lp_wall_time"])))
+                         str(cfg.get("exact", {}).get("solver", "highs")), float(e.attrs["lp_wall_time"])))
     col = lambda i: np.array([r[i] for r in rows])                        # noqa: E731
     one = lambda i, u, ln: ("pile", col(i), {"units": u, "long_name": ln})  # noqa: E731
     return xr.Dataset({"grains": one(0, "1", "grains of the pile's size (the n of its directory)"),
@@ -413,8 +413,8 @@ def exact_costs(paths):
                        "n_contacts": one(3, "1", "contacts of the pile's final state"),
                        "n_cuts": one(4, "1", "cuts of the pile (an angle range sought at each)"),
                        "n_lp": one(5, "1", "linear programs of the pile"),
-                       "simplex": ("pile", col(6).astype(str), {"units": "1", "long_name":
-                                   "simplex that restarted the LPs from the previous basis (highs or clp)"}),
+                       "solver": ("pile", col(6).astype(str), {"units": "1", "long_name":
+                                  "LP solver: highs or clp (simplex from basis to basis), clarabel (interior point)"}),
                        "lp_seconds": one(7, "s", "wall time of the pile's LPs (single-threaded)")},
                       coords={"pile": np.arange(len(rows))})
 

@@ -225,13 +225,13 @@ def dag_tables(dag):
 
 
 def exact_frame(costs):
-    """Per size and history: piles, contacts, LPs per pile, the simplex, and the LP time per
+    """Per size and history: piles, contacts, LPs per pile, the LP solver, and the LP time per
     pile (median and largest) of the exact angle ranges (:func:`ncd.studies.bench.exact_costs`)."""
     df = costs.to_dataframe()
     g = df.groupby(["grains", "history"])
     return pd.DataFrame({"piles": g.size(), "contacts (mean)": g.n_contacts.mean().round().astype(int),
                          "cuts per pile": g.n_cuts.max(), "LPs per pile (mean)": g.n_lp.mean(),
-                         "simplex": g.simplex.agg(lambda v: ", ".join(sorted(set(v)))),
+                         "solver": g.solver.agg(lambda v: ", ".join(sorted(set(v)))),
                          "LP seconds per pile (median)": g.lp_seconds.median(),
                          "LP seconds per pile (largest)": g.lp_seconds.max()})
 

@@ -4,7 +4,8 @@
 #              checkpoints in results/fig4_history/checkpoints (resumed after a kill,
 #              removed at the end)                              -> piles/n<n>/<history>_<m>.nc
 #   exact      exact angle ranges over A ∩ C at the arching cuts of the first exact.piles
-#              members of each history (HiGHS LPs, ncd.figures.history_exact)
+#              members of each history (exact.solver: HiGHS's simplex, or Clarabel's
+#              interior point for 10^4 grains; ncd.figures.history_exact)
 #                                                                -> exact/n<n>/<history>_<m>.nc
 #   analyse    ground stress, dip, arching over the piles       -> analysis_n<n>.nc
 #   notebook   notebooks/fig4_history.ipynb                     -> results/figures/fig4_history.png|pdf
@@ -71,7 +72,7 @@ FH_AFTER = ("history_analysis.py", "history_exact.py", "history_plots.py", "hist
 FH_BUILD_SOURCES = [f for f in ncd_sources(FIGH) if not f.endswith(FH_AFTER)]
 FH_PILES = piles_of(NH)
 FH_EXACT = exact_of(NH)
-# the exact ranges (pile_exact: A ∩ C by HiGHS, through history_exact) do not depend on the plots
+# the exact ranges (A ∩ C by ncd.exact, through history_exact) do not depend on the plots
 FH_EXACT_SOURCES = [f for f in ncd_sources(FIGH) if not f.endswith(("history_plots.py", "history_size.py"))]
 
 
