@@ -65,11 +65,11 @@ def exact_of(n):
             for m in range(min(c["exact"]["piles"], c["piles"]))]
 
 
-# the construction does not depend on the analysis, exact and plotting modules (editing them reruns
-# the analysis only)
+# the construction does not depend on the analysis, exact and plotting modules nor on the exact
+# layer ncd/exact (editing them reruns the exact ranges and the analysis only)
 FH_AFTER = ("history_analysis.py", "history_exact.py", "history_plots.py", "history_size.py", "pile_exact.py",
             "pressure.py")
-FH_BUILD_SOURCES = [f for f in ncd_sources(FIGH) if not f.endswith(FH_AFTER)]
+FH_BUILD_SOURCES = [f for f in ncd_sources(FIGH) if not f.endswith(FH_AFTER) and Path(f).parent.name != "exact"]
 FH_PILES = piles_of(NH)
 FH_EXACT = exact_of(NH)
 # the exact ranges (A ∩ C by ncd.exact, through history_exact) do not depend on the plots
