@@ -245,6 +245,13 @@ def test_editing_a_figure_module_reruns_that_figure_only(dag_repo, figure):
         assert {f"{f}_notebook" for f in ALL_FIGURES} <= set(core), core
 
 
+def test_editing_the_exact_layer_reruns_the_history_exact_ranges_not_the_piles(dag_repo):
+    """The pile construction imports nothing of ncd/exact: an edit there plans the exact
+    ranges of fig4_history (and what reads them), never a construction."""
+    jobs = plan_after_editing(dag_repo, "exact/interior_set.py")
+    assert "fig4_history_exact" in jobs and "fig4_history_construct" not in jobs, jobs
+
+
 def test_a_code_stamp_holds_the_hash_of_each_source_of_its_set(dag_repo):
     """A computing rule lists one stamp for its sources (results/code/<name>.sha256): the
     SHA-256 of every file of the set, by path in the checkout; the lower layers and the
