@@ -262,8 +262,9 @@ def test_exact_ranges_contain_the_history_angle(analysis, results):
     check_exact_ranges(analysis)
 
 
-def check_exact_ranges(analysis):
-    """Every exact range computed, certified and holding the history angle."""
+def check_exact_ranges(analysis, certified=1.0):
+    """Every exact range computed and holding the history angle; at least the fraction
+    ``certified`` of them certified to CERTIFIED_DEG (every one by the simplex route)."""
     cfg = yaml.safe_load(analysis.attrs["config_yaml"])
     done = analysis.exact_computed.values
     assert done.sum() == 2 * min(cfg["exact"]["piles"], cfg["piles"]) and done[:, 0].all()
@@ -279,8 +280,9 @@ def check_exact_ranges(analysis):
     # degrees; the history forces balance the weights to the equilibrium test's accuracy only,
     # which a small resultant near a toe turns into ~1e-6 degree (measured 1.2e-6 on the reduced piles)
     assert float(np.nanmax(e.exact_history_outside.values)) < 1e-5
-    # every finite range is certified (its error bound <= CERTIFIED_DEG: Dinkelbach's, or the dual's)
-    np.testing.assert_array_equal(e.exact_confirmed.values.astype(bool), ok)
+    # a certified range is a finite one (its error bound <= CERTIFIED_DEG: Dinkelbach's, or the dual's)
+    conf = e.exact_confirmed.values.astype(bool)
+    assert not np.any(conf & ~ok) and conf[ok].mean() >= certified
 
 
 def test_bands_are_over_piles(analysis, piles, results):
@@ -376,7 +378,9 @@ def test_the_largest_piles_exact_ranges_by_interior_point_hold_the_history_angle
     config/large.yaml's): the same checks as the default piles' HiGHS ranges."""
     an = xr.load_dataset(results / "fig4_history" / f"analysis_n{_sizes(results)[-1]}.nc")
     assert yaml.safe_load(an.attrs["config_yaml"])["exact"]["solver"] == "clarabel"
-    check_exact_ranges(an)
+    # the dual's bounds are coarser than Dinkelbach's: on the piles of 10^4 grains 89-90 % of
+    # the ranges were certified to 1e-5 degree (the others' bounds up to 2e-2 degree)
+    check_exact_ranges(an, certified=0.8)
 
 
 def test_size_study_states_each_sizes_exact_ranges(size, results):
@@ -398,11 +402,14 @@ def test_size_study_states_each_sizes_exact_ranges(size, results):
             assert int(x.exact_cuts) == ok.sum() and 0 < ok.sum() <= width.size
             assert float(x.exact_width_median) == pytest.approx(np.median(width[ok]), abs=1e-12)
             assert float(x.exact_width_max) == pytest.approx(width[ok].max(), abs=1e-12)
-            assert float(x.exact_confirmed) == pytest.approx(ok.mean(), abs=1e-12)   # every range certified
+            confirmed = e.exact_confirmed.values.astype(bool)
+            assert float(x.exact_confirmed) == pytest.approx(confirmed.mean(), abs=1e-12)
+            if cfg["exact"]["solver"] != "clarabel":
+                assert np.array_equal(confirmed, ok)                   # the simplex route certifies every range
             assert 0 <= float(x.exact_outside_max) < 1e-5
             grains = int(size.grains.values[z])         # the mean over piles, as the page names the size
             assert f"{grains} grains, {h}, {piles} pile(s): {ok.sum()} of {width.size} cuts have an angle range" in text
-            assert f"{ok.sum()} certified to {ha.CERTIFIED_DEG:g}°" in text
+            assert f"{confirmed.sum()} certified to {ha.CERTIFIED_DEG:g}°" in text
 
 
 def test_size_study_without_exact_ranges_says_so(analysis):

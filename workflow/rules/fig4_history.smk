@@ -218,8 +218,9 @@ rule fig4_history_size_notebook:
 
 
 rule fig4_history_size:
-    """The size study: piles of every size, their analyses and the comparison page (over an
-    hour of CPU with config/large.yaml's four piles of 10^4 grains per history; once it has
-    run, the bench page lists each job's time and the exact sets' LP time)."""
+    """The size study: piles of every size, their analyses and the comparison page (the
+    longest target: config/large.yaml's four piles of 10^4 grains per history and their
+    exact ranges; once it has run, the bench page lists each job's time and the exact sets'
+    LP time)."""
     input:
         figure_targets(FHS),
