@@ -409,7 +409,7 @@ def test_size_study_states_each_sizes_exact_ranges(size, results):
             assert 0 <= float(x.exact_outside_max) < 1e-5
             grains = int(size.grains.values[z])         # the mean over piles, as the page names the size
             assert f"{grains} grains, {h}, {piles} pile(s): {ok.sum()} of {width.size} cuts have an angle range" in text
-            assert f"{confirmed.sum()} certified to {ha.CERTIFIED_DEG:g}°" in text
+            assert f"{confirmed.sum()} certified to {ha.CERTIFIED_TEXT}°" in text
 
 
 def test_size_study_without_exact_ranges_says_so(analysis):
@@ -468,3 +468,8 @@ def test_page_figure_and_sentences(analysis, piles, results):
     texts = [text, hp.experiments_text(analysis), hp.arching_text(analysis), hp.exact_text(analysis),
              hp.finding(analysis)] + ([hp.shapes_text(analysis, cfg)] if cfg and "source" in cfg else [])
     assert not [t for t in texts if "nan" in t.lower()]
+
+
+def test_the_pages_write_the_certification_threshold_the_analysis_uses():
+    """The pages' "certified to 1e-5°" is the analysis' threshold, not a copy that drifts."""
+    assert float(ha.CERTIFIED_TEXT) == ha.CERTIFIED_DEG

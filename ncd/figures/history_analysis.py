@@ -23,6 +23,7 @@ from ncd.scenes.sources import mean_diameter
 # route's Dinkelbach bounds are ~1e-12 degree; the interior point's (the piles of 10^4 grains) reach
 # ~3e-6 degree, its dual residual (~1e-10) over the pile's summed forces (docs/solvers.md)
 CERTIFIED_DEG = 1e-5
+CERTIFIED_TEXT = "1e-5"   # CERTIFIED_DEG as the pages write it
 
 
 def _nan(stat, a, *args, **kw):
@@ -219,7 +220,7 @@ def ensemble_dataset(cfg, files, exact=None):
             "exact_history_outside": one((H, P, F, Q), ex_out, "degree", "angle of the history resultant "
                                          "outside the exact angle range (NaN: not computed)"),
             "exact_computed": one((H, P), ex_done, "1", "exact angle ranges computed for this pile"),
-            "exact_confirmed": one((H, P, F, Q), ex_conf, "1", f"exact angle range certified to {CERTIFIED_DEG:g} degree (1); "
+            "exact_confirmed": one((H, P, F, Q), ex_conf, "1", f"exact angle range certified to {CERTIFIED_TEXT} degree (1); "
                                    "0: not computed, or the admissible resultants surround zero (no range)"),
         },
         coords={H: hist, P: np.arange(n), K: widths, X: xi, F: ["left", "right"], Q: q},

@@ -8,7 +8,7 @@ lying outside their own bootstrap band (the page says why).
 import matplotlib.pyplot as plt
 import numpy as np
 
-from ncd.figures.history_analysis import CERTIFIED_DEG
+from ncd.figures.history_analysis import CERTIFIED_TEXT
 
 COLORS = {"point": "C3", "rain": "C0"}
 LABELS = {"point": "point source", "rain": "rain"}
@@ -22,7 +22,7 @@ EXACT_SUMMARY = {
     "exact_all_positive": ("1", "fraction of the cuts where every admissible resultant is steeper than the flank"),
     "exact_all_negative": ("1", "fraction of the cuts where every admissible resultant is shallower than the flank"),
     "exact_undefined": ("1", "fraction of the cuts whose admissible resultants surround zero (no angle range)"),
-    "exact_confirmed": ("1", f"fraction of the cuts whose range is certified to {CERTIFIED_DEG:g} degree"),
+    "exact_confirmed": ("1", f"fraction of the cuts whose range is certified to {CERTIFIED_TEXT} degree"),
     "exact_outside_max": ("degree", "largest angle of a history resultant outside its exact range"),
 }
 
@@ -314,7 +314,7 @@ def exact_text(an):
                      f"admissible state is steeper than the flank at {100 * x['exact_all_positive']:.0f} % of the cuts "
                      f"and every one shallower at {100 * x['exact_all_negative']:.0f} %; at "
                      f"{100 * x['exact_undefined']:.0f} % the admissible resultants surround zero (no angle range); the "
-                     f"ranges are exact (a linear-fractional program per end, each certified to {CERTIFIED_DEG:g}° at "
+                     f"ranges are exact (a linear-fractional program per end, each certified to {CERTIFIED_TEXT}° at "
                      f"{100 * x['exact_confirmed']:.0f} % of the cuts).")
     return (" ".join(parts) + " The arching angle of one force state is thus one choice among many: the spread of "
             "the history angles over piles is to be read against these ranges.")

@@ -10,7 +10,7 @@ base half-width, so profiles of every size compare directly.
 import numpy as np
 import xarray as xr
 
-from ncd.figures.history_analysis import CERTIFIED_DEG, bootstrap_index, permutation_p
+from ncd.figures.history_analysis import CERTIFIED_TEXT, bootstrap_index, permutation_p
 from ncd.figures.history_plots import COLORS, EXACT_SUMMARY, exact_summary
 
 
@@ -211,7 +211,7 @@ def exact_text(sz):
                 f"{n} grains, {h}, {x['exact_piles']:.0f} pile(s): {x['exact_cuts']:.0f} of {total} cuts have an "
                 "angle range" + (f" (the other {none} have none: the admissible resultants surround zero, or the cut crosses no "
                                  "contact)" if none else "") + ", "
-                f"{x['exact_confirmed'] * total:.0f} certified to {CERTIFIED_DEG:g}°; a range spans {x['exact_width_median']:.1f}° "
+                f"{x['exact_confirmed'] * total:.0f} certified to {CERTIFIED_TEXT}°; a range spans {x['exact_width_median']:.1f}° "
                 f"on median (at most {x['exact_width_max']:.1f}°); every admissible state is steeper than the flank at "
                 f"{100 * x['exact_all_positive']:.0f} % of the cuts and shallower at {100 * x['exact_all_negative']:.0f} "
                 f"%; the history resultant lies outside its range by at most {x['exact_outside_max']:.1e}°.")
