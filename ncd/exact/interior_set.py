@@ -42,6 +42,7 @@ FEAS_TOL = 1e-10         # Clarabel's feasibility tolerance (the primal point is
 UNIT = np.finfo(float).eps / 2     # unit round-off: the first-order error bounds of A^T y and y . b
 SOLVED = ("Solved", "AlmostSolved")
 STATIC_REG = 1e-20       # Clarabel's proportional static regularisation (default eps^2): reaches "Solved" here
+RETRY = {"max_step_fraction": 0.9}   # a second attempt at an end whose first bound is loose (a stalled solve)
 
 
 class InteriorSet:
@@ -66,16 +67,19 @@ class InteriorSet:
         self._H, self._F, self._mu = H, F, mu
 
     # ------------------------------------------------------------------ one LP
-    def _clarabel(self, cost, A, b, gap_tol=None):
+    def _clarabel(self, cost, A, b, options=None):
         """Clarabel on ``min cost . x``, ``A x = b``, ``x >= 0``: ``(x, y)`` with ``y`` the
         duals of the equations (``cost - A^T y >= 0`` up to the solver's tolerance)."""
         m, n = A.shape
         K = sp.vstack([A, -sp.identity(n, format="csc")]).tocsc()
         settings = clarabel.DefaultSettings()
         settings.verbose = False
-        settings.tol_gap_abs = settings.tol_gap_rel = self.gap_tol if gap_tol is None else gap_tol
+        settings.tol_gap_abs = settings.tol_gap_rel = self.gap_tol
         settings.tol_feas = FEAS_TOL
         settings.static_regularization_proportional = STATIC_REG
+        settings.direct_solve_method, settings.max_threads = "faer", 1     # one thread: the same point every run
+        for key, value in (options or {}).items():
+            setattr(settings, key, value)
         t0 = time.perf_counter()
         sol = clarabel.DefaultSolver(sp.csc_matrix((n, n)), np.asarray(cost, float), K,
                                      np.concatenate([b, np.zeros(n)]),
@@ -220,13 +224,22 @@ class InteriorSet:
         ends, bounds, points = [0.0, 0.0], [], np.zeros((2, L.shape[1]))
         for j, sign in ((1, 1.0), (0, -1.0)):
             cost = np.append(-sign * beta, 0.0)
-            x, y, support = self._clarabel(cost, A_cc, b_cc)
-            r = self.T @ self.admissible(x[:n] / x[n], support[:n]) * self.scale
-            u = M @ r
-            lam = sign * (b @ u) / (a @ u)
-            value, res = self._dual_value(y, b_cc), self._dual_residual(cost, A_cc, y)
-            upper = -(value - float(res.max()) * total)               # max of sign q / p, certified
-            bound = np.degrees(np.arctan(max(upper, lam)) - np.arctan(lam))
+            lam, upper = -np.inf, np.inf
+            for options in (None, RETRY):
+                # the larger attained end and the smaller certified bound, whichever solve gave them
+                x, y, support = self._clarabel(cost, A_cc, b_cc, options)
+                r_k = self.T @ self.admissible(x[:n] / x[n], support[:n]) * self.scale
+                u = M @ r_k
+                lam_k = sign * (b @ u) / (a @ u)
+                if lam_k > lam:
+                    lam, r = lam_k, r_k
+                value_k, res_k = self._dual_value(y, b_cc), self._dual_residual(cost, A_cc, y)
+                upper_k = -(value_k - float(res_k.max()) * total)       # max of sign q / p, certified
+                if upper_k < upper:
+                    upper, value, res = upper_k, value_k, res_k
+                bound = np.degrees(np.arctan(max(upper, lam)) - np.arctan(lam))
+                if bound <= BOUND_DEG:
+                    break
             if bound > BOUND_DEG:
                 # the residual's cost over A ∩ C itself: sum_j res_j zeta_j + res_t t
                 # = (res_z . z + res_t) / p <= (max res_z . z + res_t) / p_lo
