@@ -245,14 +245,24 @@ def test_bench_rules_cover_every_figure(bench_results):
 
 
 def test_bench_exact_sets_cover_every_exact_file(bench_results, results):
-    """exact_sets.nc: a row per exact file of fig4_history, its LP count and time those the file records."""
+    """exact_sets.nc: a row per exact file of fig4_history written before it (the rule globs
+    them when it runs: a size study's files appear once they exist), with the LP count and
+    time the file records, and no row without its file."""
     costs = bench_results["exact_sets"]
+    written = (results / "bench" / "exact_sets.nc").stat().st_mtime
     files = sorted((results / "fig4_history" / "exact").glob("n*/*.nc"))
-    assert costs.sizes["pile"] == len(files) > 0
-    for k, f in enumerate(files):
+    key = lambda f: (int(f.parent.name[1:]), *f.stem.split("_"))           # noqa: E731 (grains, history, member)
+    rows = {(int(g), str(h), f"{int(m):03d}"): k for k, (g, h, m) in
+            enumerate(zip(costs.grains.values, costs.history.values, costs.member.values))}
+    assert set(rows) <= {key(f) for f in files}
+    older = [f for f in files if f.stat().st_mtime <= written]
+    assert older and {key(f) for f in older} <= set(rows)
+    for f in files:
+        if key(f) not in rows:
+            continue
         e = xr.load_dataset(f)
-        row = costs.isel(pile=k)
-        assert int(row.grains) == int(f.parent.name[1:]) and str(row.history.values) == e.attrs["history"]
+        row = costs.isel(pile=rows[key(f)])
+        assert str(row.history.values) == e.attrs["history"] and int(row.member) == int(e.attrs["member"])
         assert int(row.n_lp) == int(e.n_lp.sum()) and int(row.n_contacts) == int(e.attrs["n_contacts"])
         assert float(row.lp_seconds) == float(e.attrs["lp_wall_time"]) > 0
 
