@@ -62,14 +62,15 @@ class InteriorSet:
         self.A = (fp.A_eq @ self.T).tocsc()
         self.b = np.asarray(fp.b_eq, float)
         self.gap_tol = float(validate.real("gap_tol", gap_tol, 1e-16, 1e-4))
-        self.n_lp, self.lp_time, self.log = 0, 0.0, []
+        self.n_lp, self.lp_time = 0, 0.0
         self._total, self._simplex = None, None
         self._H, self._F, self._mu = H, F, mu
 
     # ------------------------------------------------------------------ one LP
     def _clarabel(self, cost, A, b, options=None):
-        """Clarabel on ``min cost . x``, ``A x = b``, ``x >= 0``: ``(x, y)`` with ``y`` the
-        duals of the equations (``cost - A^T y >= 0`` up to the solver's tolerance)."""
+        """Clarabel on ``min cost . x``, ``A x = b``, ``x >= 0`` (``options`` override the
+        settings): ``(x, y, support)`` with ``y`` the duals of the equations (``cost - A^T y
+        >= 0`` up to the solver's tolerance) and ``support`` the columns off their bound."""
         m, n = A.shape
         K = sp.vstack([A, -sp.identity(n, format="csc")]).tocsc()
         settings = clarabel.DefaultSettings()
@@ -87,7 +88,6 @@ class InteriorSet:
         self.n_lp += 1
         self.lp_time += time.perf_counter() - t0
         status = str(sol.status)
-        self.log.append((status, int(sol.iterations), time.perf_counter() - t0))
         if status == "PrimalInfeasible":
             raise PolytopeError("A ∩ C is empty: no contact forces balance the weights")
         if status not in SOLVED:
@@ -128,13 +128,12 @@ class InteriorSet:
     def total_bound(self):
         """``S >= sum z`` over A ∩ C, certified and computed once: with ``y`` the dual of
         ``min -sum z``, ``-sum z >= y . b - w sum z`` (``w`` the dual residual and the
-        round-off of :meth:`_dual_bound`), so ``S = -y . b / (1 - w)``."""
+        round-off, :meth:`_dual_residual`), so ``S = -y . b / (1 - w)``."""
         if self._total is None:
             ones = -np.ones(self.A.shape[1])
             _, y, _ = self._clarabel(ones, self.A, self.b)
-            w = max(0.0, -float((ones - self.A.T @ y).min())) + 8 * UNIT * float((abs(self.A).T @ np.abs(y) + 1).max())
-            yb = y * self.b
-            lead = -math.fsum(yb) + 2 * UNIT * float(np.abs(yb).sum())
+            w = float(self._dual_residual(ones, self.A, y).max())
+            lead = -self._dual_value(y, self.b)
             if not w < 0.5 or not lead > 0:
                 raise PolytopeError("no certified bound on the forces of A ∩ C (unbounded or ill-posed)")
             self._total = lead / (1.0 - w)

@@ -20,10 +20,10 @@ from ncd.scenes.pile import equilibrium_problem, final_scene
 from ncd.scenes.sources import mean_diameter
 
 # an exact angle range is certified when its error bound (angle_bound) is below this: the simplex
-# route's Dinkelbach bounds are ~1e-12 degree; the interior point's (the piles of 10^4 grains) reach
-# ~3e-6 degree, its dual residual (~1e-10) over the pile's summed forces (docs/solvers.md)
+# route's Dinkelbach bounds are far below it; the interior point's (the piles of 10^4 grains) are
+# coarser, its dual residual over the pile's summed forces (docs/solvers.md)
 CERTIFIED_DEG = 1e-5
-CERTIFIED_TEXT = "1e-5"   # CERTIFIED_DEG as the pages write it
+CERTIFIED_TEXT = f"{CERTIFIED_DEG:.0e}".replace("e-0", "e-")   # as the pages write it: 1e-5
 
 
 def _nan(stat, a, *args, **kw):
