@@ -215,7 +215,7 @@ def merge_shards(paths, dim="run"):
     """Concatenate shard files along ``dim`` in member order; attrs of the first shard
     but its ``title`` (which names the shard: :func:`write_dataset` titles the merged file)."""
     parts = [xr.load_dataset(p) for p in paths]
-    ds = xr.concat(parts, dim=dim, data_vars="minimal", coords="minimal", compat="override",
+    ds = xr.concat(parts, dim=dim, data_vars="minimal", coords="minimal", compat="override", join="outer",
                    combine_attrs="override")
     ds.attrs.pop("title", None)
     for var in ds.variables.values():
