@@ -51,8 +51,8 @@ def leaves(tree, path=()):
 
 def test_the_full_overlay_only_draws_more_realizations():
     """``config/full.yaml`` keeps every size, tolerance, method and seed of config.yaml:
-    it sets realization counts only, each above the default's and at most twice it (the
-    default's members are then its first ones)."""
+    it sets realization counts only, each above the default's (the default's members are
+    then its first ones)."""
     check_config(merged(CONFIG, FULL), RULE_FILES, SCHEMAS)
     assert len(list(leaves(FULL))) >= 8
     for path, value in leaves(FULL):
@@ -60,7 +60,7 @@ def test_the_full_overlay_only_draws_more_realizations():
         for key in path:
             default = default[key]
         assert path[-1] in REALIZATIONS, f"{'.'.join(path)} is not a realization count"
-        assert type(value) is int and default < value <= 2 * default, (path, value, default)
+        assert type(value) is int and value > default, (path, value, default)
 
 
 # the ten configs that passed the schemas and planned jobs, with the text the error must hold
@@ -95,7 +95,7 @@ def test_a_config_that_slipped_through_is_refused_naming_the_key(overlay, messag
     ("fig4_pile: {grains: {radius_min: 2.0e-3}}", "fig4_pile.grains.radius_min = 0.002 must be <= "),
     ("fig4_pile: {surface: {fit_range: [0.8, 0.2]}}", "fig4_pile.surface.fit_range = [0.8, 0.2]"),
     ("fig4_pile: {tolerance_study: {runs: 600}}", "fig4_pile.tolerance_study.runs = 600 must be <= "
-                                                  "fig4_pile.ensemble.runs = 100"),
+                                                  "fig4_pile.ensemble.runs = 64"),
     ("fig2_slope: {flow: {step: 101}}", "fig2_slope.flow.step = 101 must be <= fig2_slope.flow.n_steps = 100"),
     ("fig3_equilibrium: {modes: {zero: {runs: 1.0e+4}}}", "fig3_equilibrium.modes.zero.runs = 10000.0"),
     ("fig3_equilibrium: {solver: {max_sweeps: 20000.5}}", "fig3_equilibrium.solver.max_sweeps = 20000.5"),

@@ -14,6 +14,10 @@ from pathlib import Path
 
 import pytest
 
+import ncd
+from ncd.dynamics.stepper import step
+from ncd.solver.single_contact import project_cone_py
+
 ROOT = Path(__file__).resolve().parent.parent
 PACKAGE = ROOT / "ncd"
 CONFIG = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["importlinter"]
@@ -190,3 +194,16 @@ def test_import_linter_fails_on_an_upward_import(tmp_path):
     run = lint_imports(tmp_path)
     assert run.returncode != 0
     assert "ncd.core is not allowed to import ncd.solver" in run.stdout
+
+
+def test_the_public_face_loads_its_names_on_first_use():
+    """``import ncd`` alone imports no layer that needs numba (a page render or a shard
+    merge does not pay for the stepper); every public name then resolves from its layer,
+    and a misspelt one is an AttributeError naming it."""
+    code = ("import sys, ncd; print('numba' in sys.modules, 'ncd.dynamics.stepper' in sys.modules); "
+            "print(all(getattr(ncd, n) is not None for n in ncd.__all__), 'numba' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
+    assert out == ["False", "False", "True", "True"]
+    assert ncd.step is step and ncd.project_cone is project_cone_py and "step" in dir(ncd)
+    with pytest.raises(AttributeError, match="'stpe'"):
+        ncd.stpe
