@@ -14,9 +14,9 @@ The package is layered, each subpackage importing only from those below it
 contacts, validation) < ``io`` < ``solver`` < ``exact`` | ``dynamics`` <
 ``pipeline`` < ``scenes`` < ``figures`` < ``studies`` < ``pages``.
 
-The public names load on first use (PEP 562): a workflow job that imports one layer, say
-``ncd.figures.history_exact`` or ``ncd.pages.render``, does not pay for numba and the
-stepper it never calls (0.15–0.9 s per job, over a hundred jobs per run).
+The public names load on first use (PEP 562): a workflow job that imports one layer that
+needs no kernel, say ``ncd.pages.render`` or a shard merge, does not pay for importing numba
+and the stepper, once per job over a hundred jobs per run.
 """
 import importlib
 
@@ -46,12 +46,7 @@ _PUBLIC = {
     "solve_single_contact_py": ("ncd.solver.single_contact", "solve_single_contact_py"),
 }
 
-__all__ = [
-    "Contacts", "detect_contacts", "project_cone", "solve_single_contact_py", "InputError",
-    "Scene", "SimulationError", "NLGSResult", "SolverSettings", "solve_discs", "solve_local",
-    "make_scene", "EquilibriumResult", "StepProblem", "StepReport", "equilibrium_test",
-    "kinetic_energy", "prepare_step", "solve_problem", "step", "__version__",
-]
+__all__ = [*_PUBLIC, "__version__"]
 
 
 def __getattr__(name):

@@ -225,16 +225,17 @@ class InteriorSet:
             cost = np.append(-sign * beta, 0.0)
             lam, upper = -np.inf, np.inf
             for options in (None, RETRY):
-                # the larger attained end and the smaller certified bound, whichever solve gave them
+                # the larger attained end and the smaller certified bound, whichever solve gave
+                # them (the first solve's always set them: a NaN from it then stays visible)
                 x, y, support = self._clarabel(cost, A_cc, b_cc, options)
                 r_k = self.T @ self.admissible(x[:n] / x[n], support[:n]) * self.scale
                 u = M @ r_k
                 lam_k = sign * (b @ u) / (a @ u)
-                if lam_k > lam:
+                if options is None or lam_k > lam:
                     lam, r = lam_k, r_k
                 value_k, res_k = self._dual_value(y, b_cc), self._dual_residual(cost, A_cc, y)
                 upper_k = -(value_k - float(res_k.max()) * total)       # max of sign q / p, certified
-                if upper_k < upper:
+                if options is None or upper_k < upper:
                     upper, value, res = upper_k, value_k, res_k
                 bound = np.degrees(np.arctan(max(upper, lam)) - np.arctan(lam))
                 if bound <= BOUND_DEG:
