@@ -30,8 +30,8 @@ _benchmark.BENCHMARK_INTERVAL_SHORT = max(_benchmark.BENCHMARK_INTERVAL_SHORT, 5
 # Snakemake's scheduler loop re-arms a one-second timer on each pass while jobs wait, and each
 # finished job starts one more chain of them: the loop ran about once a second per finished job
 # and its main process used 514 s of CPU on the default run, 28 s with one pending timer at a
-# time (ncd.pipeline.workflow.coalesce_reevaluations; workflow/README.md).
-from ncd.pipeline.workflow import coalesce_reevaluations
+# time (ncd.pipeline.scheduler.coalesce_reevaluations; workflow/README.md).
+from ncd.pipeline.scheduler import coalesce_reevaluations
 
 coalesce_reevaluations()
 
@@ -40,9 +40,9 @@ include: "workflow/rules/html.smk"
 
 # A run killed with SIGKILL leaves its locks: remove them (and stray *.part files) when no
 # Snakemake process or job still runs here, so that a plain rerun needs no --unlock; its
-# unfinished jobs are rerun by profiles/default (rerun-incomplete).  See ncd.pipeline.workflow.
+# unfinished jobs are rerun by profiles/default (rerun-incomplete).  See ncd.pipeline.jobs.
 if workflow.is_main_process and not workflow.dryrun:
-    from ncd.pipeline.workflow import recover_killed_run
+    from ncd.pipeline.jobs import recover_killed_run
 
     recover_killed_run(".", logger=lambda m: print(m, file=sys.stderr))
 

@@ -29,8 +29,8 @@
 # every timing rule asks for both cores, so Snakemake runs it alone):
 #
 # * `core.nc`: on dense jittered triangular packings (about three contacts per
-#   disc, `ncd.studies.bench.dense_packing`), the time per contact update of the
-#   numba NLGS sweep, and of **the same loop in C** (`ncd/studies/c_sweep.c`, gcc
+#   disc, `ncd.studies.bench.solver.dense_packing`), the time per contact update of the
+#   numba NLGS sweep, and of **the same loop in C** (`ncd/studies/bench/c_sweep.c`, gcc
 #   `-O3 -ffp-contract=off`, same packed arrays, same floating-point operations: it
 #   returns the same impulses bit for bit, column `c_agrees`), contact detection, step preparation, the time per
 #   Moreau–Jean step (warm start, fixed sweep budget) and the peak memory;
@@ -41,13 +41,13 @@
 #   of every result, which must be the same;
 # * `peer.nc`: a pile poured from a point source, the same scene in ncd and in
 #   pymunk (Chipmunk2D, C, sequential impulses) with the same number of
-#   Gauss–Seidel iterations per step (`ncd.studies.peer`);
+#   Gauss–Seidel iterations per step (`ncd.studies.bench.peer`);
 # * `rules.nc`: the wall time of every rule of the figures' run, from Snakemake's
 #   `benchmark:` files;
 # * `dag.nc`: the CPU time of every job of the default run and the critical path of its
 #   DAG (the job graph of a dry run, the times of the benchmark files);
 # * `exact_sets.nc`: the LPs and LP time of the exact angle ranges of every history pile
-#   with an exact file (`ncd.studies.bench.exact_costs`), the size study's included.
+#   with an exact file (`ncd.studies.bench.solver.exact_costs`), the size study's included.
 
 # %%
 import matplotlib
@@ -55,7 +55,7 @@ import xarray as xr
 from IPython.display import HTML, Markdown, display
 
 from ncd.pages.notebook import paths, save
-from ncd.studies import bench_page as page
+from ncd.studies.bench import page
 
 matplotlib.use("Agg")  # the figure is shown once, as the saved PNG
 
@@ -106,7 +106,7 @@ display(HTML(page.interleaved_table(core)))
 # %% [markdown]
 # ## Time against N
 #
-# Building a packing (`ncd.studies.bench.dense_packing`: positions, radii, the scene's
+# Building a packing (`ncd.studies.bench.solver.dense_packing`: positions, radii, the scene's
 # checks), preparing a step (detection, Delassus blocks), one NLGS sweep and one
 # Moreau–Jean step (warm start, NLGS to the step tolerance within its sweep budget) at
 # each size, and the exponent $p$ of the least-squares fit $t = c\,N^p$ (log–log).
@@ -196,7 +196,7 @@ display(HTML(per_fig), HTML(path), Markdown(text))
 # ## Exact sets of the history piles
 #
 # The exact angle ranges over A ∩ C at the cuts of a pile of `fig4_history`
-# (`ncd.figures.history_exact`: per cut, min p, two Charnes–Cooper LPs with their
+# (`ncd.figures.fig4_history.exact`: per cut, min p, two Charnes–Cooper LPs with their
 # certificates, and the largest vertical component), from the exact files of the run: the
 # LPs, the solver (in the default run HiGHS's simplex, restarted from the previous basis, a
 # Dinkelbach LP certifying each end; for the piles of 10⁴ grains Clarabel's interior point,

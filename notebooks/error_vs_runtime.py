@@ -28,7 +28,7 @@
 # small explicit steps.
 #
 # **What we computed.**  (1) *NLGS at one step* ($h = 10^{-3}$ s) of three states built by
-# `ncd.studies.work_precision` (a settled packing of 28 discs in a box, a small settled pile,
+# `ncd.studies.error_vs_runtime.measure` (a settled packing of 28 discs in a box, a small settled pile,
 # a step of a periodic slope flow at 24°: small stand-ins of the paper's states, not its
 # configurations): for each initial guess (zero, or the previous step's impulses), stopping
 # criterion and tolerance, the wall time (best of a few repeats), the sweeps and the distance
@@ -50,7 +50,8 @@ from IPython.display import HTML, Markdown, display
 
 from ncd.pages.claims import claim_markdown
 from ncd.pages.notebook import paths, results_dir, save
-from ncd.studies import work_precision_page as page
+from ncd.studies.error_vs_runtime import page
+from ncd.studies.error_vs_runtime.claims import JUDGES
 
 matplotlib.use("Agg")  # the figure is shown once, as the saved PNG
 # Snakemake's object, or by hand (from the repository or notebooks/) the files under results/
@@ -75,7 +76,7 @@ save(page.plot(nl, df), snakemake.output, dpi=100, show=True)
 
 # %%
 display(Markdown(page.nlgs_sentences(nl)))
-display(Markdown(claim_markdown("s2-warm-accelerates", results, "error_vs_runtime")))
+display(Markdown(claim_markdown("s2-warm-accelerates", results, JUDGES)))
 
 # %% [markdown]
 # The distance to the limit follows the natural-map residual up to a factor per state, so

@@ -41,8 +41,9 @@ import xarray as xr
 import yaml
 from IPython.display import Markdown, display
 
-from ncd.figures import wedged_page as page
-from ncd.figures.wedged import Wedge
+from ncd.figures.fig1_wedged import page
+from ncd.figures.fig1_wedged.claims import JUDGES
+from ncd.figures.fig1_wedged.measure import Wedge
 from ncd.pages.claims import claim_markdown
 from ncd.pages.notebook import paths, results_dir, save
 
@@ -74,30 +75,30 @@ save(page.plot(ens, evo, swp, wedge), snakemake.output, dpi=100, show=True)
 # %%
 display(Markdown(page.setup_sentence(wedge, float(ens.attrs["h"]))))
 display(Markdown(page.ensemble_sentence(ens, wedge)))
-display(Markdown(claim_markdown("s1-segment", results, "fig1_wedged")))
-display(Markdown(claim_markdown("s1-forces-undetermined", results, "fig1_wedged")))
+display(Markdown(claim_markdown("s1-segment", results, JUDGES)))
+display(Markdown(claim_markdown("s1-forces-undetermined", results, JUDGES)))
 
 # %% [markdown]
 # ### Which solution a run reaches
 
 # %%
 display(Markdown(page.second_contact_sentence(ens, wedge)))
-display(Markdown(claim_markdown("s2-review-orders", results, "fig1_wedged")))
+display(Markdown(claim_markdown("s2-review-orders", results, JUDGES)))
 
 # %% [markdown]
 # ### Two evolutions from one state
 
 # %%
 display(Markdown(page.evolutions_sentence(evo, wedge)))
-display(Markdown(claim_markdown("s1-two-evolutions", results, "fig1_wedged")))
-display(Markdown(claim_markdown("s1-forces-as-state", results, "fig1_wedged")))
+display(Markdown(claim_markdown("s1-two-evolutions", results, JUDGES)))
+display(Markdown(claim_markdown("s1-forces-as-state", results, JUDGES)))
 
 # %% [markdown]
 # ### The friction angle
 
 # %%
 display(Markdown(page.sweep_sentence(swp, wedge, cfg["ensemble"]["force_max"])))
-display(Markdown(claim_markdown("s1-wedging-threshold", results, "fig1_wedged")))
+display(Markdown(claim_markdown("s1-wedging-threshold", results, JUDGES)))
 
 # %% [markdown]
 # ## The closed form: the admissible contact forces and the segment of $I$
@@ -151,7 +152,7 @@ display(Markdown(claim_markdown("s1-wedging-threshold", results, "fig1_wedged"))
 # $\varphi$ with the normal line $P_iO$, and Coulomb's law is $\varphi \le \gamma$; moving $I$
 # down from $y_{\rm top}$ to the chord, $\varphi$ decreases from $\gamma$ to $\beta$.
 #
-# `ncd.figures.wedged.Wedge` implements these formulas; `tests/test_fig1_wedged.py`
+# `ncd.figures.fig1_wedged.measure.Wedge` implements these formulas; `tests/test_fig1_wedged.py`
 # checks them against a linear program on the equilibrium equations
 # $H\rho + F = 0$ built by `ncd.core.contacts.h_matrix`.
 

@@ -27,7 +27,7 @@
 # disposition of contact points at which the sliding velocity equals zero may be
 # determinant".
 #
-# **What was computed.**  The scene is built, deposited and released by `ncd.scenes.slope`:
+# **What was computed.**  The scene is built, deposited and released by `ncd.shared.slope`:
 # polydisperse discs on a rough ground of glued discs (a flat wall would let the bottom layer
 # roll), periodic along the ground; after the deposit gravity is tilted to 24° and the flow
 # is stepped with warm starts (Moreau–Jean, $\theta = 1/2$).  At the investigated step the
@@ -46,11 +46,12 @@ import matplotlib
 import xarray as xr
 from IPython.display import HTML, Markdown, display
 
-from ncd.figures import census as cs
-from ncd.figures import slope_page as page
+from ncd.figures.fig2_slope import census as cs
+from ncd.figures.fig2_slope import page
+from ncd.figures.fig2_slope.claims import JUDGES
 from ncd.pages.claims import claim_markdown
 from ncd.pages.notebook import paths, results_dir, save
-from ncd.scenes import slope_analysis as sa
+from ncd.shared import slope_analysis as sa
 
 matplotlib.use("Agg")  # the figure is shown once, as the saved PNG
 # Snakemake's object, or by hand (from the repository or notebooks/) the files under results/
@@ -89,9 +90,9 @@ display(Markdown(page.flow_sentence(traj, cfg)))
 # %%
 display(Markdown(page.spread_sentence(ens, meas, cfg)))
 display(HTML(page.tolerance_table(ens, meas).to_html(index=False)))
-display(Markdown(claim_markdown("s3-dispersion", results, "fig2_slope")))
-display(Markdown(claim_markdown("s3-warm-no-dispersion", results, "fig2_slope")))
-display(Markdown(claim_markdown("s2-warm-little-indeterminacy", results, "fig2_slope")))
+display(Markdown(claim_markdown("s3-dispersion", results, JUDGES)))
+display(Markdown(claim_markdown("s3-warm-no-dispersion", results, JUDGES)))
+display(Markdown(claim_markdown("s2-warm-little-indeterminacy", results, JUDGES)))
 
 # %%
 display(Markdown(sa.warm_check(ens, cfg["analysis"]["solution_threshold"]) or "The warm runs are plain NLGS."))
@@ -111,7 +112,7 @@ display(Markdown(sa.warm_check(ens, cfg["analysis"]["solution_threshold"]) or "T
 cloud = sa.cloud_against_census(ens, census, int(meas.attrs["grain"]), "zero")
 display(Markdown(page.solutions_sentence(meas, cfg) + "\n\n" + cs.census_text(census) + "\n\n"
                  + cs.cloud_text(cloud, int(meas.attrs["grain"]), float(ens.tol.min()), cfg["analysis"]["line_ratio"])))
-display(Markdown(claim_markdown("s3-line", results, "fig2_slope")))
+display(Markdown(claim_markdown("s3-line", results, JUDGES)))
 
 # %% [markdown]
 # ## Where the alternative is decided
@@ -125,7 +126,7 @@ display(Markdown(claim_markdown("s3-line", results, "fig2_slope")))
 display(Markdown(page.switch_sentence(meas, ens)))
 if "switched" in meas:
     display(HTML(page.switch_table(meas, cfg).to_html(index=False)))
-display(Markdown(claim_markdown("s3-sticking-determinant", results, "fig2_slope")))
+display(Markdown(claim_markdown("s3-sticking-determinant", results, JUDGES)))
 
 # %% [markdown]
 # ## How often is a step indeterminate?

@@ -35,7 +35,8 @@
 import xarray as xr
 from IPython.display import Markdown, display
 
-from ncd.figures import equilibrium_plots as ep
+from ncd.figures.fig3_equilibrium import plots as ep
+from ncd.figures.fig3_equilibrium.claims import JUDGES
 from ncd.pages.claims import claim_markdown
 from ncd.pages.notebook import paths, results_dir, save, write_finding
 
@@ -84,13 +85,13 @@ write_finding(out, ep.finding(r))
 display(Markdown(ep.packing_text(r)))
 
 # %%
-display(Markdown(claim_markdown("s4-dimension-A", results, "fig3_equilibrium")))
+display(Markdown(claim_markdown("s4-dimension-A", results, JUDGES)))
 
 # %%
-display(Markdown(claim_markdown("s4-force-set", results, "fig3_equilibrium")))
+display(Markdown(claim_markdown("s4-force-set", results, JUDGES)))
 
 # %%
-display(Markdown(claim_markdown("s2-equilibrium-test", results, "fig3_equilibrium")))
+display(Markdown(claim_markdown("s2-equilibrium-test", results, JUDGES)))
 
 # %% [markdown]
 # ## Every converged run lies in $A \cap C$
@@ -99,7 +100,7 @@ display(Markdown(claim_markdown("s2-equilibrium-test", results, "fig3_equilibriu
 display(Markdown(ep.convergence_text(r)))
 
 # %%
-display(Markdown(claim_markdown("s4-in-cones", results, "fig3_equilibrium")))
+display(Markdown(claim_markdown("s4-in-cones", results, JUDGES)))
 
 # %% [markdown]
 # ## Coverage, spread and density of the clouds
@@ -113,10 +114,10 @@ display(Markdown(claim_markdown("s4-in-cones", results, "fig3_equilibrium")))
 display(Markdown(ep.measures_table(r) + "\n\n" + ep.findings_text(r)))
 
 # %%
-display(Markdown(claim_markdown("s4-outlines", results, "fig3_equilibrium")))
+display(Markdown(claim_markdown("s4-outlines", results, JUDGES)))
 
 # %%
-display(Markdown(claim_markdown("s2-warm-accelerates", results, "fig3_equilibrium")))
+display(Markdown(claim_markdown("s2-warm-accelerates", results, JUDGES)))
 
 # %% [markdown]
 # ## Ghost images: where the solutions lie in $\mathbf{R}^{2\kappa}$
@@ -132,10 +133,10 @@ display(Markdown(claim_markdown("s2-warm-accelerates", results, "fig3_equilibriu
 display(Markdown(ep.faces_text(r)))
 
 # %%
-display(Markdown(claim_markdown("s4-ghost-images", results, "fig3_equilibrium")))
+display(Markdown(claim_markdown("s4-ghost-images", results, JUDGES)))
 
 # %%
-display(Markdown(claim_markdown("s4-denser-boundary", results, "fig3_equilibrium")))
+display(Markdown(claim_markdown("s4-denser-boundary", results, JUDGES)))
 
 # %% [markdown]
 # ## Where the reproduction differs

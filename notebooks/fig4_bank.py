@@ -70,9 +70,9 @@ from pathlib import Path
 import xarray as xr
 from IPython.display import Markdown, display
 
-from ncd.figures import bank_claims as bc
-from ncd.figures import bank_plots as bp
-from ncd.pages.claims import anchor
+from ncd.figures.fig4_bank import claims as bc
+from ncd.figures.fig4_bank import plots as bp
+from ncd.pages.claims import claim_markdown
 from ncd.pages.notebook import paths, save
 
 # Snakemake's object, or by hand (from the repository or notebooks/) the files under results/
@@ -87,7 +87,7 @@ con = xr.load_dataset(getattr(inp, "construction", results / "fig4_pile" / "cons
 
 def claim(claim_id):
     """The verdict of a claim of the paper, the same object the index prints, under the anchor it links to."""
-    return Markdown(f'<a id="{anchor(claim_id)}"></a>\n\n' + bc.verdict_markdown(bc.PAPER_CLAIMS[claim_id](results)))
+    return Markdown(claim_markdown(claim_id, results, bc.JUDGES))
 
 # %%
 fig = bp.figure(ms, exact, con)

@@ -53,7 +53,8 @@ from pathlib import Path
 import xarray as xr
 from IPython.display import Markdown, display
 
-from ncd.figures import history_plots as hp
+from ncd.figures.fig4_history import plots as hp
+from ncd.figures.fig4_history.claims import JUDGES
 from ncd.pages.claims import claim_markdown
 from ncd.pages.notebook import save, write_finding
 
@@ -95,13 +96,13 @@ display(Markdown(hp.shapes_text(an, cfg)))
 display(Markdown(hp.stress_text(an)))
 
 # %%
-display(Markdown(claim_markdown("s5-dip", results, "fig4_history")))
+display(Markdown(claim_markdown("s5-dip", results, JUDGES)))
 
 # %%
 display(Markdown(hp.experiments_text(an) + "\n\n" + hp.arching_text(an)))
 
 # %%
-display(Markdown(claim_markdown("s5-parallel-to-surface", results, "fig4_history")))
+display(Markdown(claim_markdown("s5-parallel-to-surface", results, JUDGES)))
 
 # %% [markdown]
 # **Exact ranges (sections 4-5).** The history forces are one point of the set

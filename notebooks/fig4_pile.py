@@ -38,7 +38,8 @@
 import xarray as xr
 from IPython.display import Markdown, display
 
-from ncd.figures import pile_plots as pp
+from ncd.figures.fig4_pile import plots as pp
+from ncd.figures.fig4_pile.claims import JUDGES
 from ncd.pages.claims import claim_markdown
 from ncd.pages.notebook import paths, results_dir, save, write_finding
 
@@ -118,10 +119,10 @@ display(Markdown(pp.construction_text(r)))
 display(Markdown(pp.arching_text(r)))
 
 # %%
-display(Markdown(claim_markdown("s5-parallel-to-surface", results, "fig4_pile")))
+display(Markdown(claim_markdown("s5-parallel-to-surface", results, JUDGES)))
 
 # %%
-display(Markdown(claim_markdown("s5-ten-contacts", results, "fig4_pile")))
+display(Markdown(claim_markdown("s5-ten-contacts", results, JUDGES)))
 
 # %% [markdown]
 # ## The indetermination cloud of the default cut
@@ -130,10 +131,10 @@ display(Markdown(claim_markdown("s5-ten-contacts", results, "fig4_pile")))
 display(Markdown(pp.cloud_text(r) + "\n\n" + pp.tolerance_text(r, data["tolerance"])))
 
 # %%
-display(Markdown(claim_markdown("s5-cloud", results, "fig4_pile")))
+display(Markdown(claim_markdown("s5-cloud", results, JUDGES)))
 
 # %%
-display(Markdown(claim_markdown("s5-cut-position", results, "fig4_pile")))
+display(Markdown(claim_markdown("s5-cut-position", results, JUDGES)))
 
 # %% [markdown]
 # ## The exact set of the final state
@@ -151,10 +152,10 @@ display(Markdown(claim_markdown("s5-cut-position", results, "fig4_pile")))
 display(Markdown(pp.exact_text(data["exact"], data["ensemble"], data["cuts"])))
 
 # %%
-display(Markdown(claim_markdown("s5-geometry-enough", results, "fig4_pile")))
+display(Markdown(claim_markdown("s5-geometry-enough", results, JUDGES)))
 
 # %%
-display(Markdown(claim_markdown("s6-reassuring", results, "fig4_pile")))
+display(Markdown(claim_markdown("s6-reassuring", results, JUDGES)))
 
 # %% [markdown]
 # ## Ground pressure
@@ -169,10 +170,10 @@ display(Markdown(claim_markdown("s6-reassuring", results, "fig4_pile")))
 display(Markdown(pp.pressure_text(r) + "\n\n" + pp.dip_sentence(data["exact"])))
 
 # %%
-display(Markdown(claim_markdown("s5-pressure-not-height", results, "fig4_pile")))
+display(Markdown(claim_markdown("s5-pressure-not-height", results, JUDGES)))
 
 # %%
-display(Markdown(claim_markdown("s5-dip", results, "fig4_pile")))
+display(Markdown(claim_markdown("s5-dip", results, JUDGES)))
 
 # %% [markdown]
 # ## Where the reproduction differs

@@ -37,7 +37,7 @@
 #
 # **What we compute.** Their geometry, scaled down for the default run (sizes below; their
 # size: `config/unger.yaml`). The top plate is a mobile rigid body of the scene
-# (`ncd/scenes/plates.py`): its mass enters the Delassus blocks of its contacts, NLGS moves
+# (`ncd/figures/fig5_governing/plates.py`): its mass enters the Delassus blocks of its contacts, NLGS moves
 # it as it moves a disc, and its vertical equilibrium is a row of $A$. Its contacts are
 # frictionless, so that it receives vertical forces only and translates along its normal
 # exactly; no solver kernel changes. A packing is at rest when the plate is slow and the
@@ -60,9 +60,10 @@ import numpy as np
 import xarray as xr
 from IPython.display import Markdown, display
 
-from ncd.figures import governing_claims as gc
-from ncd.figures import governing_plot as gp
-from ncd.figures import governing_summary as gs
+from ncd.figures.fig5_governing import claims as gc
+from ncd.figures.fig5_governing import plots as gp
+from ncd.figures.fig5_governing import summary as gs
+from ncd.figures.fig5_governing.claims import JUDGES
 from ncd.pages.claims import claim_markdown
 from ncd.pages.notebook import paths, save
 
@@ -161,11 +162,11 @@ display(Markdown(gs.flows_overview(flows, cfg["flows"])))
 # %%
 display(Markdown(gs.factor_text(flows)))
 for claim_id in ("s3-other-experiments", "s3-governing-parameters"):
-    display(Markdown(claim_markdown(claim_id, results, "fig5_governing")))
+    display(Markdown(claim_markdown(claim_id, results, JUDGES)))
 
 # %% [markdown]
 # ## Why a line
 
 # %%
 display(Markdown(gs.line_text(flows, cfg["flows"]["line_ratio"])))
-display(Markdown(claim_markdown("s3-line", results, "fig5_governing")))
+display(Markdown(claim_markdown("s3-line", results, JUDGES)))

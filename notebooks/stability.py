@@ -45,7 +45,8 @@ from IPython.display import HTML, Markdown, display
 
 from ncd.pages.claims import claim_markdown
 from ncd.pages.notebook import paths, results_dir, save
-from ncd.studies import stability_page as page
+from ncd.studies.stability import page
+from ncd.studies.stability.claims import JUDGES
 
 matplotlib.use("Agg")  # the figure is shown once, as the saved PNG
 
@@ -69,7 +70,7 @@ save(fig, snakemake.output, dpi=100, show=True)
 
 # %%
 display(Markdown(page.caveat_sentence(tab)))
-display(Markdown(claim_markdown("s2-stability", results, "stability")))
+display(Markdown(claim_markdown("s2-stability", results, JUDGES)))
 
 # %% [markdown]
 # ## Restitution: a binary collision and a multicontact one
@@ -81,7 +82,7 @@ display(Markdown(claim_markdown("s2-stability", results, "stability")))
 
 # %%
 display(Markdown(page.chain_sentence(tab)))
-display(Markdown(claim_markdown("s2-restitution", results, "stability")))
+display(Markdown(claim_markdown("s2-restitution", results, JUDGES)))
 
 # %% [markdown]
 # ## Where CD is not accurate, and why

@@ -9,7 +9,7 @@ checked against its source without the run (tests/test_readme.py)."""
 import sys
 from pathlib import Path
 
-from ncd.studies.bench import (
+from ncd.studies.bench.speed_table import (
     read_speed_csv,
     replace_speed_block,
     speed_block,

@@ -7,8 +7,8 @@ from step_checks import step_residual as _residual
 import ncd
 from ncd.solver import convergence, finish
 from ncd.solver.finish import check_solution
-from ncd.studies import scenes
-from ncd.studies.bench import dense_packing
+from ncd.studies import cases as scenes
+from ncd.studies.bench.solver import dense_packing
 
 H = 1e-3
 

@@ -1,6 +1,6 @@
 """The benchmark suite: what it measures must be right; its speed is not asserted.
 
-Unit checks of ncd.studies.bench on small packings, and checks of the data of the
+Unit checks of ncd.studies.bench.solver on small packings, and checks of the data of the
 reduced DAG run (``snakemake -j2 bench`` in tests/conftest.py)."""
 import shutil
 from pathlib import Path
@@ -12,7 +12,8 @@ import yaml
 
 import ncd
 from ncd.dynamics.explore import explore, run_parallel
-from ncd.studies import bench
+from ncd.studies.bench import runs, speed_table
+from ncd.studies.bench import solver as bench
 
 
 @pytest.fixture(scope="module")
@@ -77,7 +78,7 @@ def test_rule_times_reads_snakemake_benchmark_files(tmp_path):
     head = "s\th:m:s\tmax_rss\tmax_vms\tmax_uss\tmax_pss\tio_in\tio_out\tmean_load\tcpu_time\n"
     (d / "simulate.tsv").write_text(head + "12.5\t0:00:12\t250.5\t900\t200\t210\t0\t1\t95\t12\n")
     (d / "notebook.tsv").write_text(head + "3.0\t0:00:03\t-\t-\t-\t-\t-\t-\t-\t-\n")
-    ds = bench.rule_times(d.glob("*.tsv"))
+    ds = runs.rule_times(d.glob("*.tsv"))
     assert list(ds.rule.values) == ["notebook", "simulate"]
     assert list(ds.figure.values) == ["fig9", "fig9"]
     np.testing.assert_allclose(ds.seconds, [3.0, 12.5])
@@ -96,7 +97,7 @@ def test_exact_costs_reads_every_piles_exact_file(tmp_path):
     e = tmp_path / "fig4_history" / "exact"
     _exact_file(e / "n10000" / "rain_000.nc", "rain", 0, 14378, [6] * 18, 480.2, "clarabel")
     _exact_file(e / "n1000" / "point_001.nc", "point", 1, 1702, [7, 6, 6, 6], 3.5, "highs")
-    ds = bench.exact_costs(list(e.glob("n*/*.nc")))
+    ds = runs.exact_costs(list(e.glob("n*/*.nc")))
     assert list(ds.grains.values) == [1000, 10000] and list(ds.history.values) == ["point", "rain"]
     assert list(ds.member.values) == [1, 0] and list(ds.n_contacts.values) == [1702, 14378]
     assert list(ds.n_cuts.values) == [4, 18] and list(ds.n_lp.values) == [25, 108]
@@ -150,7 +151,7 @@ def test_dry_run_jobs_and_the_critical_path(tmp_path):
     is its wall time and its cost wall time x threads, whatever Snakemake's sampled cpu_time
     says (it misses children, and over-counts a notebook's kernel); the critical path is the
     longest chain."""
-    jobs = bench.dry_run_jobs(DRY_RUN)
+    jobs = runs.dry_run_jobs(DRY_RUN)
     assert [j["rule"] for j in jobs] == ["simulate", "explore", "explore", "notebook", "all"]
     assert [j["threads"] for j in jobs] == [1, 2, 2, 1, 1]
     assert jobs[2]["inputs"] == ["ncd/a.py", "results/fig9/trajectory.nc"] and jobs[4]["benchmark"] is None
@@ -160,15 +161,15 @@ def test_dry_run_jobs_and_the_critical_path(tmp_path):
     for name, wall, cpu in (("simulate", 12, 10), ("explore_0-of-2", 50, 60), ("explore_1-of-2", 50, 80),
                             ("notebook", 20, 900)):
         (d / f"{name}.tsv").write_text(head + f"{wall}\t0\t1\t1\t1\t1\t0\t0\t90\t{cpu}\n")
-    ds = bench.dag_table(jobs, tmp_path)
+    ds = runs.dag_table(jobs, tmp_path)
     np.testing.assert_allclose(ds.cpu_s, [12, 100, 100, 20])
     np.testing.assert_allclose(ds.cpu_time_s, [10, 60, 80, 900])
     np.testing.assert_allclose(ds.alone_s, [12, 50, 50, 20])
     assert list(ds.critical.values) == [1, 1, 0, 1]
     assert list(ds.critical_order.values) == [0, 1, -1, 2]
     assert ds.attrs["critical_path_s"] == 82 and ds.attrs["cpu_s"] == 232
-    assert bench.ideal_time(ds, cores=2) == 116
-    per_fig, path, text = bench.dag_summary(ds.assign_attrs(cores=2))
+    assert runs.ideal_time(ds, cores=2) == 116
+    per_fig, path, text = runs.dag_summary(ds.assign_attrs(cores=2))
     assert list(path.rule) == ["simulate", "explore_0-of-2", "notebook"] and float(per_fig.cpu_s.iloc[0]) == 232
     assert "critical path 82 s through 3 jobs" in text.lower() and "less than 116 s" in text
 
@@ -182,20 +183,20 @@ def test_speed_table_rows_round_trip(tmp_path):
     xr.Dataset({"n_discs": ("size", n), "ns_per_update": ("size", [11.0, 12.0, 14.0]),
                 "ns_per_update_c": ("size", [10.0, 11.0, 13.0]), "step_s": ("size", 1e-6 * n ** 1.1),
                 "build_s": ("size", 1e-7 * n)}, coords={"size": n}).to_netcdf(d / "core.nc")
-    rows = bench.speed_rows(tmp_path)
+    rows = speed_table.speed_rows(tmp_path)
     assert [r["value"] for r in rows] == ["1234", "457", "617", "12 / 11", "1.10", "1.00"]
-    bench.write_speed_csv(rows, tmp_path / "speed.tsv")
-    assert bench.read_speed_csv(tmp_path / "speed.tsv") == rows
-    block = bench.speed_markdown(rows)
-    text = "intro\n" + bench.speed_markdown([]) + "\nafter\n"
-    assert bench.speed_block(bench.replace_speed_block(text, block)) == block
+    speed_table.write_speed_csv(rows, tmp_path / "speed.tsv")
+    assert speed_table.read_speed_csv(tmp_path / "speed.tsv") == rows
+    block = speed_table.speed_markdown(rows)
+    text = "intro\n" + speed_table.speed_markdown([]) + "\nafter\n"
+    assert speed_table.speed_block(speed_table.replace_speed_block(text, block)) == block
     assert "| NLGS contact update, N = 10000: numba / C | 12 / 11 | ns | `results/bench/core.nc` |" in block
 
 
 def test_critical_path_refuses_a_cycle():
     with pytest.raises(ValueError, match="cycle"):
-        bench.critical_path([1.0, 1.0], [(0, 1), (1, 0)])
-    assert bench.critical_path([], []) == (0.0, [])
+        runs.critical_path([1.0, 1.0], [(0, 1), (1, 0)])
+    assert runs.critical_path([], []) == (0.0, [])
 
 
 @pytest.mark.skipif(not Path("/proc/self/status").exists(), reason="Linux only")
@@ -269,7 +270,7 @@ def test_bench_exact_sets_cover_every_exact_file(bench_results, results):
 
 def test_tolerance_table_both_methods_reach_the_tolerance():
     """Time to tolerance: plain NLGS and NLGS + finishing stage, side by side."""
-    from ncd.studies.bench import tolerance_table
+    from ncd.studies.bench.solver import tolerance_table
     ds = tolerance_table({"sizes": [100], "tolerances": [1e-6, 1e-10], "handoff": 1e-4, "max_sweeps": 100000})
     assert ds.converged.values.all()
     assert (ds.residual.values <= ds.tol.values[None, None, :]).all()

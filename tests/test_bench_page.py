@@ -1,4 +1,4 @@
-"""The speed report page (ncd/studies/bench_page.py): its sentences quote the numbers of the
+"""The speed report page (ncd/studies/bench/page.py): its sentences quote the numbers of the
 bench files, its tables are formatted HTML, its figure is readable at page width.
 
 The datasets are small and built by hand, with the variables and attributes the bench
@@ -9,7 +9,7 @@ import numpy as np
 import xarray as xr
 from figure_checks import problems
 
-from ncd.studies import bench_page as BP
+from ncd.studies.bench import page as BP
 
 matplotlib.use("Agg")
 

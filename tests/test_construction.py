@@ -19,11 +19,11 @@ import ncd
 from ncd.core.errors import InputError, SimulationError
 from ncd.core.scene import add_discs
 from ncd.dynamics import stepper
-from ncd.figures import history
-from ncd.pipeline.workflow import settings as solver_settings
-from ncd.scenes import construction, sources
-from ncd.scenes.construction import build
-from ncd.scenes.pile import add_to_pile
+from ncd.figures.fig4_history import construct as history
+from ncd.shared import construction, sources
+from ncd.shared.construction import build
+from ncd.shared.pile import add_to_pile
+from ncd.solver.settings import SolverSettings
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -85,12 +85,12 @@ def test_construction_step_tolerance_bounds_the_velocity_error(pouring):
         ref, v0, w0 = stepper.solve_problem(work, problem, guess.copy(), None, tight)
         if ref.residual < 1e-6:         # NLGS stalls near 1e-4 on a few steps: no reference there
             for tol in tols:
-                s = solver_settings({**cfg["construction"]["settings"], "tol": tol})
+                s = SolverSettings(**{**cfg["construction"]["settings"], "tol": tol})
                 res, v1, w1 = stepper.solve_problem(work, problem, guess.copy(), None, s)
                 assert res.converged and res.residual <= tol
                 du = np.concatenate([(v1 - v0)[:nm].ravel(), ((w1 - w0) * work.radius)[:nm]]) / gh
                 errors[tol].append((np.abs(du).max(), np.sqrt(np.mean(du ** 2))))
-        ncd.step(work, h, settings=solver_settings(cfg["construction"]["settings"]), init="warm")
+        ncd.step(work, h, settings=SolverSettings(**cfg["construction"]["settings"]), init="warm")
     assert len(errors[stated_tol]) >= 20
     stated, loose = (np.median(np.array(e), axis=0) for e in errors.values())
     # measured: 0.5 and 0.08 g h here (1.7 and 0.2 g h on 10^3 grains); 10x looser: 2.7 and 0.43 g h

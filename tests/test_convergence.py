@@ -5,7 +5,7 @@ import pytest
 import ncd
 from ncd.solver import convergence
 from ncd.solver.finish import relative_residual
-from ncd.studies import scenes
+from ncd.studies import cases as scenes
 
 H = 1e-3
 

@@ -6,8 +6,8 @@ from test_pile_exact import balanced
 
 import ncd
 from ncd.exact.exact_set import ExactSet
-from ncd.figures.pile_exact import resultant_angle
-from ncd.scenes import cuts as cm
+from ncd.figures.fig4_pile.exact import resultant_angle
+from ncd.shared import cuts as cm
 
 
 def lattice_pile(n_base=7, mu=0.3):

@@ -7,7 +7,7 @@ import pytest
 import xarray as xr
 
 from ncd.io.export import ExportError, animate, write_vtk
-from ncd.scenes.frames import frames_dataset
+from ncd.shared.frames import frames_dataset
 
 
 def _frames(n_frames=3, n_discs=4):
@@ -79,9 +79,9 @@ def test_no_frames_is_a_clear_error(tmp_path):
 
 
 def _construction(n_frames=3, n_discs=5):
-    """A construction file of Figure 4 with frames (ncd.scenes.construction.add_frames):
+    """A construction file of Figure 4 with frames (ncd.shared.construction.add_frames):
     grains poured one frame after another (NaN until poured), ground discs."""
-    from ncd.scenes.construction import FRAME, add_frames
+    from ncd.shared.construction import FRAME, add_frames
 
     rng = np.random.default_rng(2)
     fr = np.full((n_frames, len(FRAME), n_discs), np.nan)

@@ -10,7 +10,7 @@ from scipy.optimize import linprog
 
 import ncd
 from ncd.core.contacts import h_matrix
-from ncd.figures.wedged import Wedge, explore_shard
+from ncd.figures.fig1_wedged.measure import Wedge, explore_shard
 from ncd.io.netcdf import merge_shards, write_dataset
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -260,7 +260,7 @@ def test_evolutions_fall_and_stay_wedged(data):
 # ---------------------------------------------------------------- the page
 def test_page_sentences_count_the_runs(data):
     """The page's sentences quote the counts of the file, the left-out runs included."""
-    from ncd.figures import wedged_page as page
+    from ncd.figures.fig1_wedged import page
 
     ens, w = data["ens"], data["wedge"]
     conv, zero, out = ens.converged.values == 1, ens.zero_guess.values == 1, ens.outcome.values
@@ -283,13 +283,13 @@ def test_page_sentences_count_the_runs(data):
 def test_page_figure_is_readable(data):
     from figure_checks import problems
 
-    from ncd.figures import wedged_page as page
+    from ncd.figures.fig1_wedged import page
 
     assert problems(page.plot(data["ens"], data["evo"], data["sweep"], data["wedge"])) == []
 
 
 def test_page_sweep_sentence_matches_the_closed_form_threshold(data):
-    from ncd.figures import wedged_page as page
+    from ncd.figures.fig1_wedged import page
 
     swp, w = data["sweep"], data["wedge"]
     text = page.sweep_sentence(swp, w, data["cfg"]["ensemble"]["force_max"])
@@ -300,7 +300,7 @@ def test_page_sweep_sentence_matches_the_closed_form_threshold(data):
 def test_report_caption_counts_the_runs(data):
     from docutils.core import publish_parts
 
-    from ncd.figures import wedged_page as page
+    from ncd.figures.fig1_wedged import page
 
     ens, w = data["ens"], data["wedge"]
     text = page.caption(ens, data["sweep"], w)

@@ -12,9 +12,9 @@ import xarray as xr
 import yaml
 
 import ncd
-from ncd.figures import census
-from ncd.scenes import slope
-from ncd.scenes import slope_analysis as sa
+from ncd.figures.fig2_slope import census
+from ncd.shared import slope
+from ncd.shared import slope_analysis as sa
 
 
 # ------------------------------------------------------------------ measures
@@ -194,7 +194,7 @@ def test_the_notebook_states_the_verdict_and_the_cloud_shape(data, results):
     ratio = float(meas.ratio.sel(init="zero", tol=ens.tol.min(), disc=grain))
     assert f"{ratio:.1e}" in html
     # the prose describes the cloud from the census (which solutions, how far from them)
-    from ncd.figures import census as cs
+    from ncd.figures.fig2_slope import census as cs
     cen = xr.load_dataset(results / "fig2_slope" / "census.nc")
     cloud = sa.cloud_against_census(ens, cen, grain, "zero")
     assert cs.cloud_text(cloud, grain, float(ens.tol.min()), an["line_ratio"]) in md
@@ -221,7 +221,7 @@ def test_the_page_sentences_quote_the_files(data):
     """The page's sentences and tables count what the files hold; its figure is readable."""
     from figure_checks import problems
 
-    from ncd.figures import slope_page as page
+    from ncd.figures.fig2_slope import page
 
     traj, ens, meas, _, an = data
     cfg = {**yaml.safe_load(traj.attrs["config_yaml"]), "analysis": an}
@@ -393,8 +393,8 @@ def test_census_solutions_are_exact_and_contain_the_nlgs_end_points(data, result
     componentwise; every converged NLGS run of the ensemble ends on one of them; the census
     recomputes its solutions' accelerations from its impulses."""
     from ncd.dynamics.stepper import prepare_step
-    from ncd.scenes.slope import scene_at_step
-    from ncd.scenes.step_solutions import StepSolutions
+    from ncd.shared.slope import scene_at_step
+    from ncd.shared.step_solutions import StepSolutions
     traj, ens, meas, cfg, an = data
     cen = xr.load_dataset(results / "fig2_slope" / "census.nc")
     ccfg = yaml.safe_load(cen.attrs["config_yaml"])

@@ -14,8 +14,8 @@ from ncd.core.contacts import h_matrix
 from ncd.dynamics.explore import member_rng
 from ncd.exact.polygon import boundary_distance, convex_hull, outside_distance, polygon_area
 from ncd.exact.polytope import ForcePolytope, PolytopeError
-from ncd.figures import equilibrium as fe
-from ncd.scenes.packing import external_force, rest_problem
+from ncd.figures.fig3_equilibrium import measure as fe
+from ncd.figures.fig3_equilibrium.packing import external_force, rest_problem
 
 
 # ---------------------------------------------------------------- unit tests
@@ -119,7 +119,7 @@ def test_active_faces_and_polygon_helpers():
 def test_face_census_of_the_shared_load():
     """The triangle problem of _shared_load: a vertex (contact 1 sliding at full load,
     contact 2 without force), an interior point, and a point where both slide."""
-    from ncd.figures import faces
+    from ncd.figures.fig3_equilibrium import faces
     mu = 0.5
     P = _shared_load(mu)
     pts = np.array([[1.0, mu, 0.0, 0.0], [0.5, 0.0, 0.5, 0.0], [0.5, 0.25, 0.5, -0.25]])
@@ -198,7 +198,7 @@ def test_cloud_measures_of_the_displayed_contacts(fig3):
 def test_face_statements_over_every_run(fig3):
     """The notebook's face statements are measured over all runs: every zero-guess run on a
     proper face, the warm runs interior, and the text says what the counts say."""
-    from ncd.figures import faces
+    from ncd.figures.fig3_equilibrium import faces
     ens, P = fig3["ensemble"], fig3["P"]
     modes = {m: np.stack([fe.mode_subset(ens, m).force_n.values, fe.mode_subset(ens, m).force_t.values],
                          -1).reshape(fe.mode_subset(ens, m).sizes["run"], -1) for m in fe.MODES}
@@ -235,10 +235,10 @@ def test_members_do_not_depend_on_the_shard_count(fig3):
     np.testing.assert_array_equal(warm.force_n.values, ens.sel(run=warm.run.values).force_n.values)
 
 
-# ------------------------------------------------------------------ the page (ncd.figures.equilibrium_plots)
+# ------------------------------------------------------------------ the page (ncd.figures.fig3_equilibrium.plots)
 @pytest.fixture(scope="module")
 def page_run(fig3):
-    from ncd.figures import equilibrium_plots as ep
+    from ncd.figures.fig3_equilibrium import plots as ep
 
     return ep.Fig3Run(fig3["state"], fig3["ensemble"], fig3["projection"], fig3["uniform"])
 
@@ -251,7 +251,7 @@ def test_page_figure_is_legible(page_run):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from ncd.figures import equilibrium_plots as ep
+    from ncd.figures.fig3_equilibrium import plots as ep
     from ncd.pages.notebook import MIN_FONT_PT, text_layout
 
     fig = ep.figure(page_run)
@@ -265,7 +265,7 @@ def test_page_figure_is_legible(page_run):
 def test_page_sentences_follow_the_data(page_run, fig3):
     """The table and sentences of the page carry the measured numbers: converged counts, the
     coverage of each displayed contact, the face census (every uniform point interior)."""
-    from ncd.figures import equilibrium_plots as ep
+    from ncd.figures.fig3_equilibrium import plots as ep
 
     r = page_run
     conv = ep.convergence_text(r)

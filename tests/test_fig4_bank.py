@@ -11,13 +11,13 @@ import yaml
 
 from ncd.core.contacts import Contacts, detect_contacts, h_matrix
 from ncd.core.scene import make_scene
-from ncd.core.verdict import VERDICTS, Verdict
 from ncd.exact.exact_set import ExactSet
-from ncd.figures import bank_claims
+from ncd.figures.fig4_bank import claims as bank_claims
+from ncd.figures.fig4_bank import stress as st
 from ncd.io.netcdf import missing_metadata
 from ncd.pipeline.config import ConfigError, check_config
-from ncd.scenes import cuts as cm
-from ncd.scenes import stress as st
+from ncd.shared import cuts as cm
+from ncd.shared.verdict import VERDICTS, Verdict
 
 # Stated bounds
 ROUND_OFF = 1e-9          # relative: an LP vertex balances every grain to about 1e-13 of the weights
@@ -272,7 +272,7 @@ def test_claims_and_page(results):
     import re
 
     html = (results / "html" / "fig4_bank.html").read_text(encoding="utf-8")
-    for claim_id, f in bank_claims.PAPER_CLAIMS.items():
+    for claim_id, (f,) in bank_claims.JUDGES.items():
         v = f(results)
         assert v.verdict in VERDICTS and v.verdict != "not computed"
         assert v.value and v.criterion and all((results / p).exists() for p in v.data)

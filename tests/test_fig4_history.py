@@ -13,9 +13,9 @@ import pytest
 import xarray as xr
 import yaml
 
-from ncd.figures import history
-from ncd.figures import history_analysis as ha
-from ncd.scenes import construction
+from ncd.figures.fig4_history import analysis as ha
+from ncd.figures.fig4_history import construct as history
+from ncd.shared import construction
 
 ROOT = Path(__file__).resolve().parent.parent
 WEIGHT_TOL = 1e-9            # every pile: vertical ground reaction vs weight (relative)
@@ -189,7 +189,7 @@ def test_profile_and_dip_by_hand():
 
 
 def test_a_cut_crossing_no_contact_has_no_direction():
-    from ncd.scenes import cuts
+    from ncd.shared import cuts
     # arctan2(-0.0, -0.0) is -180 degrees: an empty left cut read as a 163-degree "deviation"
     phi, dev = cuts.flank_angles(np.array([-0.0, 0.0, -2.0]), np.array([0.0, -0.0, -1.0]),
                                  np.array([-1, 1, -1]), 16.5)
@@ -387,7 +387,7 @@ def test_the_largest_piles_exact_ranges_by_interior_point_hold_the_history_angle
 def test_size_study_states_each_sizes_exact_ranges(size, results):
     """size.nc carries, per size and history, the exact ranges of the piles that have them,
     recomputed here from each analysis; the page's sentence states them."""
-    from ncd.figures import history_size as hsz
+    from ncd.figures.fig4_history import size as hsz
 
     text = hsz.exact_text(size)
     for z, n in enumerate(_sizes(results)):
@@ -414,7 +414,7 @@ def test_size_study_states_each_sizes_exact_ranges(size, results):
 
 
 def test_size_study_without_exact_ranges_says_so(analysis):
-    from ncd.figures import history_size as hsz
+    from ncd.figures.fig4_history import size as hsz
 
     bare = analysis.drop_vars([v for v in analysis.data_vars if v.startswith("exact_")])
     sz = hsz.size_dataset([analysis, bare.assign(n_grains=bare.n_grains * 10)])
@@ -427,7 +427,7 @@ def test_size_study_without_exact_ranges_says_so(analysis):
 def test_size_comparison_sees_a_shift_and_not_a_null(analysis):
     """Two copies of one analysis: no change (p = 1); a copy with every cut deviation 5° larger
     and ten times the grains: an arching change of exactly 5° and an unchanged dip."""
-    from ncd.figures import history_size as hsz
+    from ncd.figures.fig4_history import size as hsz
 
     same = hsz.size_dataset([analysis, analysis.assign(n_grains=analysis.n_grains * 10)])
     assert np.all(same.arching_size_diff.values[1] == 0) and np.all(same.arching_size_p.values[1] == 1)
@@ -448,7 +448,7 @@ def test_page_figure_and_sentences(analysis, piles, results):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from ncd.figures import history_plots as hp
+    from ncd.figures.fig4_history import plots as hp
     from ncd.pages.notebook import MIN_FONT_PT, text_layout
 
     first = {ds.attrs["history"]: ds for ds in piles if ds.attrs["member"] == 0}

@@ -10,10 +10,11 @@ import yaml
 
 import ncd
 from ncd.core.contacts import Contacts, h_matrix, match_warm
-from ncd.figures import pile, pile_exact
-from ncd.scenes import construction
-from ncd.scenes import cuts as cm
-from ncd.scenes import pile as pile_scenes
+from ncd.figures.fig4_pile import exact as pile_exact
+from ncd.figures.fig4_pile import measure as pile
+from ncd.shared import construction
+from ncd.shared import cuts as cm
+from ncd.shared import pile as pile_scenes
 
 # Stated bounds of the figure-data tests
 MAX_DEVIATION_DEG = 10.0     # resultant across the default cut vs the free-surface slope
@@ -353,10 +354,10 @@ def test_rest_runs_ground_pressure_lies_in_its_exact_band(data):
                                                      * yaml.safe_load(ex.attrs["config_yaml"])["exact"]["kernel_d"])
 
 
-# ------------------------------------------------------------------ the page (ncd.figures.pile_plots)
+# ------------------------------------------------------------------ the page (ncd.figures.fig4_pile.plots)
 @pytest.fixture(scope="module")
 def page_run(data):
-    from ncd.figures import pile_plots
+    from ncd.figures.fig4_pile import plots as pile_plots
 
     cfg = yaml.safe_load(data["cuts"].attrs["config_yaml"])
     return pile_plots.PileRun(data["construction"], data["cuts"], data["ensemble"], data["exact"], cfg)
@@ -369,7 +370,7 @@ def test_page_figure_is_legible(page_run):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from ncd.figures import pile_plots
+    from ncd.figures.fig4_pile import plots as pile_plots
     from ncd.pages.notebook import MIN_FONT_PT, text_layout
 
     fig = pile_plots.figure(page_run)
@@ -384,7 +385,7 @@ def test_page_sentences_follow_the_data(page_run, data):
     """The cloud sentence states the diameter of the rest runs' cloud and compares it with the
     changes of a cut moved by one diameter the way the numbers do; the tolerance study is one
     sentence when plain NLGS brings too few runs to rest; no sentence prints NaN."""
-    from ncd.figures import pile_plots
+    from ncd.figures.fig4_pile import plots as pile_plots
 
     r = page_run
     P = r.cloud(r.K)

@@ -13,12 +13,12 @@ import yaml
 import ncd
 from ncd.core.contacts import h_matrix
 from ncd.exact.polytope import ForcePolytope
-from ncd.figures import governing as fg
-from ncd.figures import governing_claims as gc
-from ncd.figures import governing_exact as ge
-from ncd.figures import governing_line as gl
-from ncd.figures import governing_unger as gu
-from ncd.scenes import plates
+from ncd.figures.fig5_governing import claims as gc
+from ncd.figures.fig5_governing import exact as ge
+from ncd.figures.fig5_governing import line as gl
+from ncd.figures.fig5_governing import measure as fg
+from ncd.figures.fig5_governing import plates
+from ncd.figures.fig5_governing import unger as gu
 
 
 # ---------------------------------------------------------------- unit tests
@@ -272,7 +272,7 @@ def test_walk_samples_are_inside_the_exact_ranges(packings):
 
 
 def test_claims_are_measured(results):
-    from ncd.core.verdict import NOT_TESTED, VERDICTS
+    from ncd.shared.verdict import NOT_TESTED, VERDICTS
     for claim in (gc.claim_unger_peak, gc.claim_unger_vanishes, gc.claim_unger_control, gc.claim_unger_centrality):
         v = claim(results)
         assert v.verdict in VERDICTS[:2] + (NOT_TESTED,) and v.anchor.startswith("unger-") and "nan" not in v.value
@@ -395,7 +395,7 @@ def flows(results):
 def test_flow_study_design(flows):
     """Every setting of the one-factor-at-a-time design has its seeds, and every scan
     is accounted for (indeterminate, determinate or unknown)."""
-    from ncd.figures import governing_flow as gf
+    from ncd.figures.fig5_governing import flow as gf
     cfg = yaml_config(flows)["flows"]
     tab = gf.settings_table(cfg)
     assert flows.sizes["flow"] == len(tab["mu"]) * cfg["seeds"]
@@ -427,7 +427,7 @@ def test_indeterminate_steps_have_distinct_exact_solutions(flows):
 
 
 def test_flow_tables(flows):
-    from ncd.figures import governing_summary as gs
+    from ncd.figures.fig5_governing import summary as gs
     m = gs.flow_measures(flows)
     ok = np.isfinite(m["indeterminate"])
     assert ((m["indeterminate"][ok] >= 0) & (m["indeterminate"][ok] <= 1)).all()
@@ -440,7 +440,7 @@ def test_flow_tables(flows):
 
 
 def test_flow_settings_one_factor_at_a_time():
-    from ncd.figures import governing_flow as gf
+    from ncd.figures.fig5_governing import flow as gf
     f = dict(base={"mu": 0.5, "h": 5e-4, "slope_deg": 24.0}, mu=[0.1, 0.3, 0.8], h=[2e-4, 2e-3], slope_deg=[20.0],
              duration=0.05, scan_every=0.005)
     t = gf.settings_table(f)

@@ -9,7 +9,7 @@ from ncd.core.scene import make_scene
 from ncd.solver import convergence, finish, finish_lp
 from ncd.solver.finish import check_solution
 from ncd.solver.single_contact import NO_CONTACT, SLIDE_BACKWARD, SLIDE_FORWARD, STICK
-from ncd.studies import scenes
+from ncd.studies import cases as scenes
 
 H = 1e-3
 

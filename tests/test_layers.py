@@ -1,11 +1,12 @@
 """The layer contract of ncd: imports go down only, no cycles, no private names across
-modules, no figure importing another figure's modules, no function-local imports of ncd.
+modules, no figure package importing another figure's (nor a study another study's), no
+function-local imports of ncd.
 
 Two checkers read the same order: import-linter (``lint-imports``, configured in
-pyproject.toml) and the AST reader below, which also sees the rules import-linter has
-no contract for.  Both are shown to fail on a deliberately upward import.
+pyproject.toml) and the AST reader of :mod:`ncd.pipeline.imports` (the one the workflow
+reads a rule's code inputs with), which also sees the rules import-linter has no contract
+for.  Both are shown to fail on a deliberately broken contract.
 """
-import ast
 import shutil
 import subprocess
 import sys
@@ -16,12 +17,15 @@ import pytest
 
 import ncd
 from ncd.dynamics.stepper import step
+from ncd.pipeline.imports import imports_of, module_name
 from ncd.solver.single_contact import project_cone_py
 
 ROOT = Path(__file__).resolve().parent.parent
 PACKAGE = ROOT / "ncd"
 CONFIG = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["importlinter"]
 LAYERS = CONFIG["contracts"][0]["layers"]            # top first, as import-linter reads them
+# the packages that must not import each other (the independence contracts)
+INDEPENDENT = [c["modules"] for c in CONFIG["contracts"] if c["type"] == "independence"]
 
 
 def layer_rank():
@@ -33,42 +37,18 @@ def layer_rank():
     return rank
 
 
-def module_name(path, package):
-    parts = list(path.relative_to(package.parent).with_suffix("").parts)
-    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
-
-
-def imports_of(path, package):
-    """``(target module, names, lineno, function_local)`` of every ncd import of ``path``."""
-    mod = module_name(path, package)
-    pkg = mod if path.name == "__init__.py" else mod.rpartition(".")[0]
-    found = []
-
-    def walk(node, local):
-        for child in ast.iter_child_nodes(node):
-            inner = local or isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda))
-            if isinstance(child, ast.ImportFrom):
-                if child.level:
-                    base = pkg.split(".")[:len(pkg.split(".")) - child.level + 1]
-                    target = ".".join(base + ([child.module] if child.module else []))
-                else:
-                    target = child.module or ""
-                if target == "ncd" or target.startswith("ncd."):
-                    found.append((target, [a.name for a in child.names], child.lineno, local))
-            elif isinstance(child, ast.Import):
-                for a in child.names:
-                    if a.name == "ncd" or a.name.startswith("ncd."):
-                        found.append((a.name, [], child.lineno, local))
-            walk(child, inner)
-    walk(ast.parse(path.read_text()), False)
-    return found
+def group_of(module):
+    """The independent package (a figure's or a study's) that holds ``module``, or None."""
+    for group in INDEPENDENT:
+        for pkg in group:
+            if module == pkg or module.startswith(pkg + "."):
+                return pkg
+    return None
 
 
 def violations(package=PACKAGE):
     """Every breach of the contract in the package at ``package``, as readable lines."""
-    from ncd.figures import FIGURE_MODULES
     rank = layer_rank()
-    figure_of = {f"ncd.figures.{m}": fig for fig, mods in FIGURE_MODULES.items() for m in mods}
     modules = {module_name(p, package): p for p in package.rglob("*.py")}
     out, edges = [], {m: set() for m in modules}
     for mod, path in sorted(modules.items()):
@@ -88,8 +68,9 @@ def violations(package=PACKAGE):
                     out.append(f"{where}: {mod} imports {t}, which is in no layer")
                 elif rank[tl] > rank[layer] or (rank[tl] == rank[layer] and tl != layer):
                     out.append(f"{where}: {mod} ({layer}) imports {t} ({tl}): upward or sideways")
-                if t in figure_of and mod in figure_of and figure_of[t] != figure_of[mod]:
-                    out.append(f"{where}: {mod} ({figure_of[mod]}) imports {t} of {figure_of[t]}")
+                mine, theirs = group_of(mod), group_of(t)
+                if mine and theirs and mine != theirs:
+                    out.append(f"{where}: {mod} ({mine}) imports {t} of {theirs}")
                 if t != mod and t in modules:
                     edges[mod].add(t)
             if local:
@@ -142,11 +123,20 @@ def test_every_subpackage_is_in_a_layer():
     assert [p.name for p in PACKAGE.glob("*.py")] == ["__init__.py"]     # no module outside a layer
 
 
-def test_every_figure_module_belongs_to_one_figure():
-    from ncd.figures import FIGURE_MODULES
-    listed = [m for mods in FIGURE_MODULES.values() for m in mods]
-    present = sorted(p.stem for p in (PACKAGE / "figures").glob("*.py") if p.stem != "__init__")
-    assert sorted(listed) == present
+def test_every_figure_and_study_is_a_package_named_by_its_config_key():
+    """A reader who knows the config key knows the folder: ncd/figures/<key>/ for each
+    figure of config.yaml, ncd/studies/<key>/ for each study; no loose module beside them
+    but the ones several share (ncd/studies/cases.py); each package is independent."""
+    import yaml
+    keys = set(yaml.safe_load((ROOT / "config.yaml").read_text()))
+    figures = {p.parent.name for p in (PACKAGE / "figures").glob("*/__init__.py")}
+    studies = {p.parent.name for p in (PACKAGE / "studies").glob("*/__init__.py")}
+    assert figures | studies <= keys
+    assert figures == {k for k in keys if k.startswith("fig")}
+    assert [p.name for p in (PACKAGE / "figures").glob("*.py")] == ["__init__.py"]
+    assert sorted(p.name for p in (PACKAGE / "studies").glob("*.py")) == ["__init__.py", "cases.py"]
+    groups = {m for g in INDEPENDENT for m in g}
+    assert groups == {f"ncd.figures.{f}" for f in figures} | {f"ncd.studies.{s}" for s in studies}
 
 
 def copy_with(tmp_path, module, line):
@@ -164,7 +154,9 @@ def copy_with(tmp_path, module, line):
     ("exact/polygon.py", "from ncd.dynamics.explore import member_rng", "sideways"),
     ("solver/kernels.py", "from ncd.solver.nlgs import solve_local", "import cycle"),
     ("solver/nlgs.py", "from ncd.core.validate import _shape_text", "private name"),
-    ("figures/history.py", "from ncd.figures.governing import eta_table", "imports ncd.figures.governing of"),
+    ("figures/fig4_history/construct.py", "from ncd.figures.fig5_governing.measure import eta_table",
+     "imports ncd.figures.fig5_governing.measure of ncd.figures.fig5_governing"),
+    ("studies/bench/page.py", "from ncd.studies.stability.page import inaccurate", "of ncd.studies.stability"),
     ("core/model.py", "import ncd", "public face"),
 ])
 def test_the_checker_fails_on_a_broken_contract(tmp_path, module, line, expected):
@@ -186,7 +178,7 @@ def lint_imports(package_parent):
 def test_import_linter_keeps_the_contract():
     run = lint_imports(ROOT)
     assert run.returncode == 0, run.stdout + run.stderr
-    assert "1 kept, 0 broken" in run.stdout
+    assert f"{len(CONFIG['contracts'])} kept, 0 broken" in run.stdout
 
 
 def test_import_linter_fails_on_an_upward_import(tmp_path):

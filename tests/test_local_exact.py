@@ -14,7 +14,7 @@ from step_checks import step_residual as _residual
 
 import ncd
 from ncd.dynamics.stepper import initial_guess
-from ncd.scenes.slope import scene_at_step
+from ncd.shared.slope import scene_at_step
 from ncd.solver import anderson, local_exact
 from ncd.solver.finish import check_solution, global_delassus, natural_map
 

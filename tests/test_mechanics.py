@@ -575,7 +575,7 @@ def test_a_separating_contact_with_zero_impulse_has_zero_natural_map(mu):
 def test_frictionless_chain_steps_converge_after_the_impact():
     """Newton's cradle with e = 1 (mu = 0): after the multi-contact impact the discs
     separate at rounding-level speeds; every step must be reported converged."""
-    from ncd.studies import scenes
+    from ncd.studies import cases as scenes
     s = scenes.chain(5, 1.0, e=1.0)
     settings = ncd.SolverSettings(tol=1e-8, max_sweeps=2000)
     reports = [ncd.step(s, 1e-3, settings=settings) for _ in range(30)]

@@ -1,4 +1,4 @@
-"""ncd against pymunk (Chipmunk2D) on a small poured pile (:mod:`ncd.studies.peer`).
+"""ncd against pymunk (Chipmunk2D) on a small poured pile (:mod:`ncd.studies.bench.peer`).
 
 40 discs on a ground 15 diameters wide, the default h = 1 ms and 10 sweeps per
 step: about 3,500 steps per engine, a few seconds in all.  The bounds were
@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from ncd.core.errors import InputError
-from ncd.studies.peer import DEFAULTS, SLOP_D, compare
+from ncd.studies.bench.peer import DEFAULTS, SLOP_D, compare
 
 pytest.importorskip("pymunk")
 

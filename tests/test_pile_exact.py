@@ -1,4 +1,4 @@
-"""The exact set A ∩ C of small piles (ncd.figures.pile_exact) and the ground-pressure maps."""
+"""The exact set A ∩ C of small piles (ncd.figures.fig4_pile.exact) and the ground-pressure maps."""
 import numpy as np
 import pytest
 
@@ -6,8 +6,8 @@ import ncd
 from ncd.core.contacts import h_matrix
 from ncd.exact.exact_set import ExactSet
 from ncd.exact.polytope import ForcePolytope
-from ncd.figures.pile_exact import resultant_angle
-from ncd.scenes import pressure as pm
+from ncd.figures.fig4_pile import pressure as pm
+from ncd.figures.fig4_pile.exact import resultant_angle
 
 
 def balanced(scene):

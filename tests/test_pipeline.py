@@ -260,7 +260,7 @@ def test_a_code_stamp_holds_the_hash_of_each_source_of_its_set(dag_repo):
     lines = (dag_repo / "results" / "code" / "fig1_wedged.sha256").read_text().splitlines()
     stamp = dict(reversed(line.split("  ", 1)) for line in lines)
     assert len(stamp) == len(lines) > 20
-    assert {"ncd/solver/nlgs.py", "ncd/core/contacts.py", "ncd/figures/wedged.py"} <= set(stamp)
+    assert {"ncd/solver/nlgs.py", "ncd/core/contacts.py", "ncd/figures/fig1_wedged/measure.py"} <= set(stamp)
     assert not [p for p in stamp if p.startswith("ncd/pages/") or p.endswith("_page.py")]
     for path, digest in stamp.items():
         assert hashlib.sha256((dag_repo / path).read_bytes()).hexdigest() == digest, path
@@ -317,7 +317,7 @@ def test_an_ensemble_is_identical_with_its_attributes_whatever_the_shard_count(d
 def test_a_failing_job_writes_its_traceback_to_its_log(tmp_path):
     """An uncaught exception of a script reaches its ``log:`` file, not only the console."""
     (tmp_path / "fail.py").write_text(
-        "from ncd.pipeline.workflow import start\n"
+        "from ncd.pipeline.jobs import start\n"
         "log = start(snakemake)\n"
         "log.info('about to fail')\n"
         "def deep(x):\n    raise ValueError(f'no such member: {x}')\n"
@@ -338,7 +338,7 @@ def test_the_scheduler_keeps_one_pending_reevaluation_whatever_the_wake_ups():
     a request after that wake-up arms a new timer."""
     import threading
 
-    from ncd.pipeline.workflow import coalesce_reevaluations
+    from ncd.pipeline.scheduler import coalesce_reevaluations
 
     class Scheduler:
         def __init__(self):
@@ -365,7 +365,7 @@ def test_the_scheduler_loop_runs_about_twice_per_job_not_once_per_finished_job_p
     adding one pass per second)."""
     assert "coalesce_reevaluations()" in (ROOT / "Snakefile").read_text()
     (tmp_path / "Snakefile").write_text(
-        "from ncd.pipeline.workflow import coalesce_reevaluations\n"
+        "from ncd.pipeline.scheduler import coalesce_reevaluations\n"
         "coalesce_reevaluations()\n"
         "rule all:\n    input: expand('out/{i}.txt', i=range(12))\n"
         "rule job:\n    output: 'out/{i}.txt'\n    shell: 'sleep 1; touch {output}'\n")
@@ -379,7 +379,7 @@ def test_the_scheduler_loop_runs_about_twice_per_job_not_once_per_finished_job_p
 
 def test_sigterm_of_a_job_is_logged_and_runs_its_cleanup(tmp_path):
     """A job terminated by SIGTERM (Snakemake cancelling it) exits 143 through ``finally``."""
-    code = ("import time, types\nfrom ncd.pipeline.workflow import start\n"
+    code = ("import time, types\nfrom ncd.pipeline.jobs import start\n"
             f"log = start(types.SimpleNamespace(threads=1, rule='demo', log=[{str(tmp_path / 'j.log')!r}]))\n"
             "try:\n    print('ready', flush=True)\n    time.sleep(60)\n"
             f"finally:\n    open({str(tmp_path / 'cleaned')!r}, 'w').close()\n")
@@ -413,7 +413,7 @@ def test_an_interrupted_run_reruns_without_flags_and_gives_the_same_file(dag_rep
     """Kill Snakemake in the middle of an ensemble job (fig1's first shard), then a plain rerun:
     no --unlock, no --rerun-incomplete; no half-written output at any time; the
     interrupted job is redone and the merged file equals the uninterrupted run's."""
-    from ncd.pipeline.workflow import _snakemake_processes
+    from ncd.pipeline.jobs import _snakemake_processes
 
     work = tmp_path / "work"
     target = "results/fig1_wedged/ensemble.nc"

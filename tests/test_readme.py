@@ -1,17 +1,24 @@
 """The README is a user guide: its solver example runs, it keeps no hand-typed measured
 numbers (it points to results/index.html and the bench page, built from the data), it
 stays short, its pictures exist, config/README.md is up to date, docs/solvers.md has a
-section per solver method, and neither uses words of the project's process."""
+section per solver method, and neither uses words of the project's process.  Neither do
+the other guides of docs/, the comments of the configuration files and the comments of
+ncd/exact/ type measured numbers."""
+import io
 import re
 import subprocess
 import sys
+import tokenize
 from pathlib import Path
 
-from ncd.studies.bench import SPEED_START, read_speed_csv, speed_block, speed_markdown
+from ncd.studies.bench.speed_table import SPEED_START, read_speed_csv, speed_block, speed_markdown
 
 ROOT = Path(__file__).resolve().parent.parent
 README = (ROOT / "README.md").read_text()
 SOLVERS = ROOT / "docs" / "solvers.md"
+DOCS = sorted((ROOT / "docs").glob("*.md"))         # markdown only: docs/speed.tsv is generated data
+CONFIGS = [ROOT / "config.yaml", *sorted((ROOT / "config").glob("*.yaml"))]
+COMMENTED = sorted((ROOT / "ncd" / "exact").glob("*.py"))
 MAX_LINES = 220
 
 
@@ -21,13 +28,41 @@ def section(title, text=README):
     return text[start:end if end > 0 else None]
 
 
+def _newlines(match):
+    return "\n" * match.group(0).count("\n")
+
+
 def prose(text):
     """``text`` without fenced code blocks, inline code, HTML tags and the generated speed
-    table (checked against its source by test_speed_table_is_the_generated_one)."""
-    text = text.replace(speed_block(text), "") if SPEED_START in text else text
-    text = re.sub(r"```.*?```", "", text, flags=re.DOTALL)
+    table (checked against its source by test_speed_table_is_the_generated_one); what is
+    removed leaves its line breaks, so a line of the prose is that line of the file."""
+    if SPEED_START in text:
+        block = speed_block(text)
+        text = text.replace(block, "\n" * block.count("\n"))
+    text = re.sub(r"```.*?```", _newlines, text, flags=re.DOTALL)
     text = re.sub(r"`[^`\n]*`", "", text)
-    return re.sub(r"<[^>]*>", "", text)
+    return re.sub(r"<[^>]*>", _newlines, text)
+
+
+def yaml_comments(text):
+    """The comments of a YAML file, line for line: a line starting with ``#``, or the part
+    of a line after `` # `` (keys and values are left out: they are parameters)."""
+    out = []
+    for line in text.splitlines():
+        if line.lstrip().startswith("#"):
+            out.append(line.lstrip()[1:])
+        else:
+            out.append(line.split(" # ", 1)[1] if " # " in line else "")
+    return "\n".join(out)
+
+
+def python_comments(text):
+    """The ``#`` comments of a Python source, line for line (code and strings left out)."""
+    out = [""] * (text.count("\n") + 1)
+    for tok in tokenize.generate_tokens(io.StringIO(text).readline):
+        if tok.type == tokenize.COMMENT:
+            out[tok.start[0] - 1] = tok.string[1:]
+    return "\n".join(out)
 
 
 # A number followed by a unit of time, a speed-up factor, a percentage or a count of
@@ -36,6 +71,14 @@ MEASURED = re.compile(
     r"\d[\d.,]*\s*(?:[-–]\s*\d[\d.,]*\s*)?"
     r"(?:(?:s|sec|secs|seconds?|min|mins|minutes?|ms|µs|us|ns|h|hours?)\b|[x×](?![\w])|%"
     r"|\s*(?:sweeps?|tests?|jobs?|passed|failed|skipped|runs?|orders?)\b)", re.IGNORECASE)
+
+
+def measured(name, text):
+    """``name:line: match`` for every hand-typed measured number of ``text`` (a prose, or
+    comments, whose lines are those of the file ``name``)."""
+    return [f"{name}:{text.count(chr(10), 0, m.start()) + 1}: {m.group(0).strip()}" for m in MEASURED.finditer(text)]
+
+
 COMMIT = re.compile(r"(?<![\w-])(?=[0-9a-f]*[a-f])(?=[0-9a-f]*[0-9])[0-9a-f]{7,40}(?![\w-])")
 ISSUE = re.compile(r"\bissues?\s*#?\s*\d+|#\d+\b", re.IGNORECASE)
 
@@ -83,6 +126,36 @@ def test_speed_table_is_the_generated_one():
     assert out.returncode == 0, out.stdout
 
 
+def test_no_measured_numbers_in_docs_config_comments_and_exact_comments():
+    """The guides of docs/ (speed.tsv, generated data, is not one), the comments of
+    config.yaml and config/*.yaml, and the ``#`` comments of ncd/exact/ say why in words and
+    point to the pages that measure: no timing, speed-up, percentage or count typed there."""
+    assert SOLVERS in DOCS and all(p.suffix == ".md" for p in DOCS)
+    found = []
+    for path in DOCS:
+        found += measured(path.relative_to(ROOT).as_posix(), prose(path.read_text()))
+    for path in CONFIGS:
+        found += measured(path.relative_to(ROOT).as_posix(), yaml_comments(path.read_text()))
+    for path in COMMENTED:
+        found += measured(path.relative_to(ROOT).as_posix(), python_comments(path.read_text()))
+    assert not found, "hand-typed measured numbers:\n" + "\n".join(found)
+
+
+def test_measured_numbers_are_named_by_file_and_line():
+    """A negative control: the scan of each kind of file catches a typed timing and names
+    its line; numbers that are not measurements pass."""
+    assert measured("a.md", prose("Intro.\n\n```\nx = 1\n```\nIt took 31 s.\n")) == ["a.md:6: 31 s"]
+    yaml = "fig:\n  # built once; it took 31 s\n  runs: 200   # took 31 s\n  h: 2.0e-4   # s\n"
+    assert measured("c.yaml", yaml_comments(yaml)) == ["c.yaml:2: 31 s", "c.yaml:3: 31 s"]
+    code = 'TOL = 1e-9   # took 31 s\ns = "took 31 s"\n# took 31 s\n'
+    assert measured("m.py", python_comments(code)) == ["m.py:1: 31 s", "m.py:3: 31 s"]
+    for text in ("bounds below 1e-5 degree", "Figure 4", "§5", "(κ − 1)!", "10^4 grains", "`max_sweeps: 200000`",
+                 "Moreau 2005, §2–§5"):
+        assert not measured("a.md", prose(text)), text
+    assert not measured("c.yaml", yaml_comments("  runs: 2000             # random initial guesses\n"
+                                                "  h: 1.0e-3                # time step (s)\n"))
+
+
 def test_measurement_pattern_catches_the_usual_forms():
     for text in ("took 29 min", "in 6 min 4 s", "0.25 s", "12 ns", "a 1.97× speed-up", "3x faster",
                  "27 %", "514 tests", "168 jobs", "150,930 sweeps", "139 passed", "2.6–6.9 s"):
@@ -98,9 +171,9 @@ def test_readme_is_short():
 
 
 def test_no_history_of_the_work():
-    """No commit hashes, issue numbers or sessions: the README and docs/solvers.md say what
-    is, not how it came to be."""
-    for path in (ROOT / "README.md", SOLVERS):
+    """No commit hashes, issue numbers or sessions: the README and the guides of docs/ say
+    what is, not how it came to be."""
+    for path in (ROOT / "README.md", *DOCS):
         text = path.read_text()
         assert not COMMIT.findall(text), f"{path.name}: commit hashes {COMMIT.findall(text)}"
         assert not ISSUE.findall(text), f"{path.name}: issue numbers {ISSUE.findall(text)}"

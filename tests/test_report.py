@@ -8,10 +8,13 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from ncd.core.verdict import DIFFERS, NOT_COMPUTED, NOT_TESTED, REPRODUCED, VERDICTS
-from ncd.figures import FIGURE_MODULES
+from ncd.figures.fig1_wedged import claims as fig1
+from ncd.figures.fig2_slope import claims as fig2
+from ncd.figures.fig4_pile import claims as fig4
 from ncd.pages import claims as C
+from ncd.pages.registry import JUDGES_BY_FIGURE
 from ncd.pages.report import build_page, claim_rows, run_times, section_of
+from ncd.shared.verdict import DIFFERS, NOT_COMPUTED, NOT_TESTED, REPRODUCED, VERDICTS, anchor
 
 ROOT = Path(__file__).resolve().parents[1]
 PAPER = ROOT.parent / "shared" / "paper" / "moreau-2005-indetermination.txt"
@@ -28,13 +31,14 @@ def _normal(text):
 
 def test_every_claim_is_judged_or_has_a_reason():
     ids = {c["id"] for c in C.CLAIMS}
-    assert set(C.MEASURES) <= ids and set(C.UNTESTED_REASONS) <= ids
+    judged = {k for judges in JUDGES_BY_FIGURE.values() for k in judges}
+    assert judged <= ids and set(C.UNTESTED_REASONS) <= ids
     for c in C.CLAIMS:
-        figs = [f for f, _ in C.MEASURES.get(c["id"], [])]
+        figs = [f for f, _ in C.measures_of(c["id"], JUDGES_BY_FIGURE)]
         assert figs or c["id"] in C.UNTESTED_REASONS, c["id"]
         assert sorted(set(figs)) == sorted(c["figures"]), (c["id"], figs, c["figures"])
         assert section_of(c) in c["section"]
-    known = set(FIGURE_MODULES) | {"stability", "error_vs_runtime"}
+    known = set(JUDGES_BY_FIGURE)
     assert {f for c in C.CLAIMS for f in c["figures"]} <= known
 
 
@@ -67,10 +71,10 @@ def _sweep(tmp_path, fractions):
 
 def test_threshold_verdict_follows_the_data(tmp_path):
     _sweep(tmp_path, [0.0, 0.0, 0.4, 0.6])
-    m = C.fig1_threshold(tmp_path)
+    m = fig1.fig1_threshold(tmp_path)
     assert m.verdict == REPRODUCED and "first at 25.0°" in m.value
     _sweep(tmp_path, [0.0, 0.1, 0.4, 0.6])  # wedging below the threshold: the claim fails
-    assert C.fig1_threshold(tmp_path).verdict == DIFFERS
+    assert fig1.fig1_threshold(tmp_path).verdict == DIFFERS
 
 
 def _cuts(tmp_path, x, fx, cloud):
@@ -94,10 +98,10 @@ def _cuts(tmp_path, x, fx, cloud):
 def test_cut_position_is_a_may_over_pairs_of_cuts(tmp_path):
     # cuts one diameter apart: changes 1.0, 0.1, 0.1; the cloud is 0.2 across
     _cuts(tmp_path, [0.0, 1.0, 2.0, 3.0], [0.0, 1.0, 1.1, 1.2], [0.0, 0.2])
-    v = C.fig4_cut_vs_cloud(tmp_path)
+    v = fig4.fig4_cut_vs_cloud(tmp_path)
     assert v.verdict == REPRODUCED and "3 pairs" in v.value and "33.3 % of pairs" in v.value
     _cuts(tmp_path, [0.0, 1.0, 2.0, 3.0], [0.0, 0.3, 0.6, 0.9], [0.0, 0.2])   # every change below 0.4
-    assert C.fig4_cut_vs_cloud(tmp_path).verdict == DIFFERS
+    assert fig4.fig4_cut_vs_cloud(tmp_path).verdict == DIFFERS
 
 
 def _measures(tmp_path, zero, warm):
@@ -112,14 +116,14 @@ def _measures(tmp_path, zero, warm):
 
 def test_warm_start_judged_where_the_zero_guess_spread_has_settled(tmp_path):
     _measures(tmp_path, [0.5, 5.4, 5.6], [0.4, 0.05, 1e-5])     # loose tolerance: both are iteration error
-    assert C.warm_little(tmp_path).verdict == REPRODUCED
+    assert fig2.warm_little(tmp_path).verdict == REPRODUCED
     _measures(tmp_path, [0.5, 5.4, 5.6], [0.4, 0.9, 1e-5])      # at 1e-5 the warm spread is not small
-    assert C.warm_little(tmp_path).verdict == DIFFERS
+    assert fig2.warm_little(tmp_path).verdict == DIFFERS
 
 
 def test_claim_markdown_carries_the_index_verdict_and_anchor(tmp_path):
     _sweep(tmp_path, [0.0, 0.0, 0.4, 0.6])
-    text = C.claim_markdown("s1-wedging-threshold", tmp_path)
+    text = C.claim_markdown("s1-wedging-threshold", tmp_path, fig1.JUDGES)
     assert '<a id="claim-s1-wedging-threshold"></a>' in text and f"**{REPRODUCED}**" in text
     rows = dict((c["id"], v) for c, _, v in claim_rows(tmp_path) if c["id"] == "s1-wedging-threshold")
     assert rows["s1-wedging-threshold"].value in text
@@ -153,7 +157,7 @@ def test_each_page_states_the_index_verdict(results):
         end = at
         while True:        # the block runs to the next anchor that is not this claim's own
             end = text.find('<a id="', end + 10)
-            if end < 0 or not text.startswith((f'<a id="{C.anchor(c["id"])}"', f'<a id="{v.anchor}"'), end):
+            if end < 0 or not text.startswith((f'<a id="{anchor(c["id"])}"', f'<a id="{v.anchor}"'), end):
                 break
         block = html_lib.unescape(re.sub(r"<[^>]+>", "", text[at:end if end > 0 else at + 20000]))
         if v.verdict not in block or v.value[:60] not in block:

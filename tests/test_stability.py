@@ -103,7 +103,7 @@ def test_unconverged_steps_go_on_from_the_last_sweep():
 
     import yaml
 
-    from ncd.studies import stability as S
+    from ncd.studies.stability import measure as S
 
     cfg = yaml.safe_load((Path(__file__).resolve().parent.parent / "config.yaml").read_text())["stability"]
     assert cfg["solver"]["keep_best"] is False

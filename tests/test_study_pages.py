@@ -12,8 +12,8 @@ import numpy as np
 import xarray as xr
 from figure_checks import problems
 
-from ncd.studies import stability_page as SP
-from ncd.studies.stability import OBSERVABLE_LABEL
+from ncd.studies.stability import page as SP
+from ncd.studies.stability.measure import OBSERVABLE_LABEL
 
 matplotlib.use("Agg")
 
@@ -73,8 +73,8 @@ def test_stability_figure_is_readable():
 
 
 def test_stability_page_rule_is_the_index_rule(results):
-    """The page and the index count the same inaccurate runs (the index imports the page's rule)."""
-    from ncd.pages import claims
+    """The page and the index count the same inaccurate runs (the study's claims import the page's rule)."""
+    from ncd.studies.stability import claims
 
     tab = xr.load_dataset(results / "stability" / "table.nc")
     assert claims.inaccurate is SP.inaccurate
@@ -87,7 +87,7 @@ def test_stability_page_rule_is_the_index_rule(results):
 def test_stability_table_labels_its_observable_as_a_value(tmp_path):
     """What the study writes: ``observable`` labelled as the case's value, not its name."""
     from ncd.io.netcdf import write_dataset
-    from ncd.studies.stability import to_dataset
+    from ncd.studies.stability.measure import to_dataset
 
     row = dict(case="e1_chain", observable=0.4, observable_ref=1.0, max_penetration=0.0, trace=np.zeros(3),
                sweeps_mean=1.0, residual_max=1e-9)
@@ -149,7 +149,7 @@ def small_integration():
 
 
 def test_warm_start_saving_is_read_both_ways():
-    from ncd.studies import work_precision_page as WP
+    from ncd.studies.error_vs_runtime import page as WP
 
     nl = small_nlgs()
     assert np.allclose(WP.sweep_ratios(nl).sel(state="rest"), 4.0)
@@ -162,7 +162,7 @@ def test_warm_start_saving_is_read_both_ways():
 
 
 def test_integration_sentences_and_tables():
-    from ncd.studies import work_precision_page as WP
+    from ncd.studies.error_vs_runtime import page as WP
 
     df = small_integration()
     text = WP.integration_sentences(df)
@@ -173,13 +173,13 @@ def test_integration_sentences_and_tables():
 
 
 def test_work_precision_figure_is_readable():
-    from ncd.studies import work_precision_page as WP
+    from ncd.studies.error_vs_runtime import page as WP
 
     assert problems(WP.plot(small_nlgs(), small_integration())) == []
 
 
 def test_work_precision_page_on_the_run(results):
-    from ncd.studies import work_precision_page as WP
+    from ncd.studies.error_vs_runtime import page as WP
 
     nl = xr.load_dataset(results / "error_vs_runtime" / "nlgs.nc")
     df = xr.load_dataset(results / "error_vs_runtime" / "integration.nc").to_dataframe()
@@ -193,7 +193,7 @@ def test_captions_state_the_finding():
     """The report captions are sentences from the data (valid reStructuredText, no placeholder)."""
     from docutils.core import publish_parts
 
-    from ncd.studies import work_precision_page as WP
+    from ncd.studies.error_vs_runtime import page as WP
 
     for text in (SP.caption(small_table()), WP.caption(small_nlgs(), small_integration())):
         assert "<" not in text and "TODO" not in text

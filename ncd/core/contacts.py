@@ -14,14 +14,18 @@ i.e. ``U = H^T u``; the impulse ``s = (s_n, s_t)`` acts on a as the force
 ``W = H^T M^-1 H`` (diagonal for discs: ``1/m`` normal, ``1/m + r^2/I``
 tangential per mobile disc).
 """
+from __future__ import annotations
+
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
+from numpy.typing import ArrayLike
 
 from ncd.core.detection import check_detection_args, disc_pairs
 from ncd.core.errors import InputError
 from ncd.core.jit import njit
+from ncd.core.model import Scene
 from ncd.core.validate import array, first_bad, is_f64, shape_of, show
 
 
@@ -42,14 +46,14 @@ class Contacts:
     e_t: np.ndarray       # (n,) tangential restitution
 
     @property
-    def n(self):
+    def n(self) -> int:
         return len(self.body_a)
 
     @property
-    def tangent(self):
+    def tangent(self) -> np.ndarray:
         return np.column_stack([-self.normal[:, 1], self.normal[:, 0]])
 
-    def subset(self, mask):
+    def subset(self, mask: ArrayLike) -> Contacts:
         return Contacts(**{k: v[mask] for k, v in self.__dict__.items()})
 
 
@@ -63,7 +67,7 @@ def pair_key(body_a, body_b, n_disc):
     return key
 
 
-def detect_contacts(scene, alert=0.0, pos=None, check=True):
+def detect_contacts(scene: Scene, alert: float = 0.0, pos: ArrayLike | None = None, check: bool = True) -> Contacts:
     """Contacts of ``scene`` (at positions ``pos``, default its own) with gap <= alert.
 
     Disc pairs come from the O(N) grid of :mod:`ncd.core.detection`; disc-wall pairs
@@ -217,7 +221,7 @@ def local_velocity(body_a, body_b, normal, arm_a, arm_b, vel, spin, out):
     return out
 
 
-def match_warm(contacts, prev_keys, prev_impulse):
+def match_warm(contacts: Contacts, prev_keys: np.ndarray | None, prev_impulse: np.ndarray | None) -> np.ndarray:
     """Previous impulses of persisting contacts (matched by body pair), zero elsewhere."""
     if prev_keys is None or len(prev_keys) == 0 or contacts.n == 0:
         return np.zeros((contacts.n, 2))
@@ -238,7 +242,7 @@ def _match_sorted(keys, prev_keys, prev_impulse):
     return guess
 
 
-def h_matrix(scene, contacts):
+def h_matrix(scene: Scene, contacts: Contacts) -> sp.csr_matrix:
     """The sparse matrix ``H`` (3 n_mobile, 2 n): generalized force of the impulses.
 
     Rows ``3 i, 3 i + 1, 3 i + 2`` are the force x, y and torque on mobile disc

@@ -6,6 +6,8 @@ the ``n_mobile`` mobile discs come first, the fixed obstacle discs after them
 ``(x - point) . normal >= 0``.  A slope is a tilted gravity vector.
 Mass ``m = density * pi r^2`` (a 2-D density), inertia ``I = m r^2 / 2``.
 """
+from __future__ import annotations
+
 import numbers
 from dataclasses import dataclass, field
 
@@ -45,18 +47,18 @@ class Scene:
     spin: np.ndarray = field(default=None)
     time: float = 0.0
     # warm-start memory: the previous step's contacts (keys) and impulses
-    prev_keys: np.ndarray = field(default=None)
-    prev_impulse: np.ndarray = field(default=None)
+    prev_keys: np.ndarray | None = field(default=None)
+    prev_impulse: np.ndarray | None = field(default=None)
 
     @property
-    def n_disc(self):
+    def n_disc(self) -> int:
         return len(self.radius)
 
     @property
-    def mobile_mass(self):
+    def mobile_mass(self) -> np.ndarray:
         return self.mass[: self.n_mobile]
 
-    def copy(self):
+    def copy(self) -> Scene:
         """A deep copy (state included)."""
         kw = {k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in self.__dict__.items()}
         return Scene(**kw)
@@ -66,7 +68,7 @@ class Scene:
 MASS_RTOL = 1e-12         # |mass inv_mass - 1| of a mobile disc (make_scene: 1 / mass, a rounding at most)
 
 
-def check_scene(s, name="scene", state=False):
+def check_scene(s: Scene, name: str = "scene", state: bool = False) -> Scene:
     """A :class:`ncd.Scene` whose arrays are consistent: the shapes the kernels
     index, finite radii, masses and laws.  The *state* (``pos``, ``vel``,
     ``spin``, ``angle``) is only shape-checked: a state gone non-finite is a
@@ -84,7 +86,7 @@ def check_scene(s, name="scene", state=False):
     return s
 
 
-def check_period(name, value, largest_radius):
+def check_period(name: str, value: float, largest_radius: float) -> None:
     """A period along x is 0 (not periodic) or at least three largest diameters (a pair of
     discs then touches across it once at most)."""
     if value > 0 and value < 6 * largest_radius:

@@ -1,5 +1,10 @@
 """Building a validated :class:`ncd.core.model.Scene` from physical data."""
+from __future__ import annotations
+
+from collections.abc import Iterable
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ncd.core import validate
 from ncd.core.contacts import detect_contacts
@@ -7,7 +12,7 @@ from ncd.core.errors import InputError
 from ncd.core.model import Scene, check_period, check_scene
 
 
-def _disc_mass(density, radius, label):
+def _disc_mass(density: np.ndarray, radius: np.ndarray, label: str) -> np.ndarray:
     """Masses of discs (2-D: ``rho pi r^2``), checked with their inertias ``m r^2 / 2`` to be
     finite, positive and invertible in double precision; ``label`` names a disc in the error."""
     with np.errstate(all="ignore"):
@@ -21,10 +26,13 @@ def _disc_mass(density, radius, label):
     return mass
 
 
-def make_scene(pos, radius, density=1.0, *, obstacle_pos=None, obstacle_radius=None,
-               walls=(), gravity=(0.0, -9.81), mu=0.5, mu_obstacle=None,
-               e_n=0.0, e_t=0.0, e_n_obstacle=None, e_t_obstacle=None, period=None,
-               vel=None, spin=None, angle=None, overlap_tolerance=1e-2):
+def make_scene(pos: ArrayLike, radius: ArrayLike, density: ArrayLike = 1.0, *,
+               obstacle_pos: ArrayLike | None = None, obstacle_radius: ArrayLike | None = None,
+               walls: Iterable[tuple[ArrayLike, ArrayLike]] = (), gravity: ArrayLike = (0.0, -9.81),
+               mu: float = 0.5, mu_obstacle: float | None = None, e_n: float = 0.0, e_t: float = 0.0,
+               e_n_obstacle: float | None = None, e_t_obstacle: float | None = None, period: float | None = None,
+               vel: ArrayLike | None = None, spin: ArrayLike | None = None, angle: ArrayLike | None = None,
+               overlap_tolerance: float = 1e-2) -> Scene:
     """Build and validate a scene.
 
     ``walls`` is a sequence of ``(point, normal)`` pairs; ``period`` (> 0)
@@ -110,7 +118,9 @@ def make_scene(pos, radius, density=1.0, *, obstacle_pos=None, obstacle_radius=N
     return scene
 
 
-def add_discs(scene, pos, radius, density=1.0, *, vel=None, spin=None, angle=None, overlap_tolerance=1e-2):
+def add_discs(scene: Scene, pos: ArrayLike, radius: ArrayLike, density: ArrayLike = 1.0, *,
+              vel: ArrayLike | None = None, spin: ArrayLike | None = None, angle: ArrayLike | None = None,
+              overlap_tolerance: float = 1e-2) -> Scene:
     """``scene`` with mobile discs appended after its own: a new scene, equal to the
     :func:`make_scene` of all the discs (obstacles, walls, laws kept; its time too).
 
@@ -118,7 +128,7 @@ def add_discs(scene, pos, radius, density=1.0, *, vel=None, spin=None, angle=Non
     validated and given masses (the same formulas, hence the same bits for the old ones,
     whose arrays are taken from ``scene``), while the overlap check covers every disc as
     :func:`make_scene` does.  The warm-start memory is not carried (its keys depend on
-    the disc count: :func:`ncd.scenes.construction.carry_warm` re-encodes it)."""
+    the disc count: :func:`ncd.shared.construction.carry_warm` re-encodes it)."""
     check_scene(scene, state=True)
     pos = validate.array("pos", pos, (None, 2))
     k = len(pos)
@@ -138,7 +148,7 @@ def add_discs(scene, pos, radius, density=1.0, *, vel=None, spin=None, angle=Non
                          f"got {np.abs(pos).max():.3g}")
     nm = scene.n_mobile
 
-    def insert(old, new):
+    def insert(old: np.ndarray, new: np.ndarray) -> np.ndarray:
         return np.concatenate([old[:nm], new, old[nm:]])
 
     out = Scene(
@@ -153,7 +163,7 @@ def add_discs(scene, pos, radius, density=1.0, *, vel=None, spin=None, angle=Non
     return out
 
 
-def check_overlaps(scene, tolerance):
+def check_overlaps(scene: Scene, tolerance: float) -> None:
     """Raise :class:`InputError` if any pair interpenetrates by more than
     ``tolerance`` times the smaller radius."""
     c = detect_contacts(scene, alert=0.0)

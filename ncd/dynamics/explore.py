@@ -7,7 +7,7 @@ from ``numpy.random.default_rng((member, root_seed))``, so a member gives the
 same result whatever shard or process runs it.
 
 The members of an ensemble run in parallel on ``threads`` threads (default:
-numba's thread count, which :func:`ncd.pipeline.workflow.start` sets from the rule's
+numba's thread count, which :func:`ncd.pipeline.jobs.start` sets from the rule's
 ``threads``): the NLGS kernels release the GIL, every member runs serially on
 its own copies of the velocities and impulses, so the results are identical
 bit for bit whatever the thread count.

@@ -16,13 +16,17 @@ The report of each step carries the largest interpenetration (``-min gap`` at
 ``q_m``), the NLGS sweeps, change, residual and converged flag.  A state that
 goes non-finite or faster than ``speed_limit`` raises :class:`SimulationError`.
 """
+from __future__ import annotations
+
 import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ncd.core import validate
 from ncd.core.contacts import (
+    Contacts,
     check_contacts,
     check_disc_blocks,
     delassus_blocks,
@@ -32,11 +36,11 @@ from ncd.core.contacts import (
 )
 from ncd.core.errors import InputError, SimulationError
 from ncd.core.jit import njit
-from ncd.core.model import check_scene
+from ncd.core.model import Scene, check_scene
 from ncd.core.validate import array, real, shape_of, show
 from ncd.solver.finish import global_delassus
-from ncd.solver.nlgs import restitution_bias, solve_discs
-from ncd.solver.settings import SolverSettings, check_settings_arg
+from ncd.solver.nlgs import Delassus, Observer, restitution_bias, solve_discs
+from ncd.solver.settings import NLGSResult, SolverSettings, check_settings_arg
 
 
 @dataclass
@@ -44,7 +48,7 @@ class StepProblem:
     """The core problem of one step: contacts, Delassus blocks, free velocities."""
     h: float
     theta: float
-    contacts: object
+    contacts: Contacts
     W: np.ndarray
     free_vel: np.ndarray
     free_spin: np.ndarray
@@ -53,9 +57,10 @@ class StepProblem:
     angle_mid: np.ndarray
     vel_initial: np.ndarray
     spin_initial: np.ndarray
-    _delassus: tuple = dataclasses.field(default=None, init=False, repr=False, compare=False)
+    _delassus: tuple[Scene, Delassus] | None = dataclasses.field(default=None, init=False, repr=False,
+                                                                 compare=False)
 
-    def delassus(self, scene):
+    def delassus(self, scene: Scene) -> Delassus:
         """``(W, H, M^-1)`` of :func:`ncd.solver.finish.global_delassus`, built at the first
         call and kept: the finishing stage and local exact solves of every run of an
         ensemble on this problem share it (a run of Figure 3 cost three times its sweeps
@@ -65,7 +70,7 @@ class StepProblem:
         return self._delassus[1]
 
     @property
-    def max_penetration(self):
+    def max_penetration(self) -> float:
         return float(max(0.0, -self.contacts.gap.min())) if self.contacts.n else 0.0
 
 
@@ -90,7 +95,8 @@ def _finite(a):
 
 
 @validate.finite_problem
-def prepare_step(scene, h, theta=0.5, gap_tolerance=None, vel=None, spin=None, check=True):
+def prepare_step(scene: Scene, h: float, theta: float = 0.5, gap_tolerance: float | None = None,
+                 vel: np.ndarray | None = None, spin: np.ndarray | None = None, check: bool = True) -> StepProblem:
     """Build the core problem of the step from the current state (or ``vel, spin``).
 
     ``check=False``: the caller has checked the arguments (:func:`step` does, once per
@@ -120,8 +126,9 @@ def prepare_step(scene, h, theta=0.5, gap_tolerance=None, vel=None, spin=None, c
                        pos_mid, angle_mid, vel.copy(), spin.copy())
 
 
-def solve_problem(scene, problem, guess=None, review_order=None, settings=SolverSettings(), observe=None,
-                  check=True):
+def solve_problem(scene: Scene, problem: StepProblem, guess: ArrayLike | None = None,
+                  review_order: ArrayLike | None = None, settings: SolverSettings = SolverSettings(),
+                  observe: Observer | None = None, check: bool = True) -> tuple[NLGSResult, np.ndarray, np.ndarray]:
     """Solve a prepared step; returns ``(result, vel_f, spin_f)`` without touching the scene.
 
     ``observe(impulse, vel, spin) -> 1-D array``: the figure's observable, scaled to
@@ -139,7 +146,7 @@ def solve_problem(scene, problem, guess=None, review_order=None, settings=Solver
     return result, vel, spin
 
 
-def initial_guess(scene, problem, init):
+def initial_guess(scene: Scene, problem: StepProblem, init: str | ArrayLike) -> np.ndarray | None:
     """``init``: "zero", "warm" (previous impulses matched by body pair) or an array."""
     if not isinstance(init, str):
         return validate.impulse_guess("init", init, problem.contacts.n)
@@ -152,8 +159,9 @@ def initial_guess(scene, problem, init):
     return np.asarray(init, dtype=float).reshape(problem.contacts.n, 2)
 
 
-def step(scene, h, theta=0.5, settings=SolverSettings(), init="warm", review_order=None,
-         gap_tolerance=None, speed_limit=np.inf):
+def step(scene: Scene, h: float, theta: float = 0.5, settings: SolverSettings = SolverSettings(),
+         init: str | ArrayLike = "warm", review_order: ArrayLike | None = None, gap_tolerance: float | None = None,
+         speed_limit: float = np.inf) -> StepReport:
     """Advance ``scene`` by one Moreau-Jean step in place; returns a :class:`StepReport`."""
     h, theta = check_step_call(scene, h, theta, settings, init, gap_tolerance, speed_limit)
     # checked once here; the stages below skip their own checks of the same arguments
@@ -189,12 +197,13 @@ class EquilibriumResult:
     at_rest: bool
     max_velocity: float      # max |u_f| over translation and r * spin, relative to |g| h
     forces: np.ndarray       # (n, 2) contact forces r = s / h
-    contacts: object
-    result: object
+    contacts: Contacts
+    result: NLGSResult
 
 
-def equilibrium_test(scene, h, settings=SolverSettings(), init="zero", review_order=None,
-                     velocity_tol=1e-6, gap_tolerance=None):
+def equilibrium_test(scene: Scene, h: float, settings: SolverSettings = SolverSettings(),
+                     init: str | ArrayLike = "zero", review_order: ArrayLike | None = None,
+                     velocity_tol: float = 1e-6, gap_tolerance: float | None = None) -> EquilibriumResult:
     """One step from zero velocity: is ``u_f = 0`` (within ``velocity_tol * |g| h``)?
 
     The scene is not modified.  The contact forces are ``r = s / h``.
@@ -213,7 +222,7 @@ def equilibrium_test(scene, h, settings=SolverSettings(), init="zero", review_or
 
 
 @validate.finite_value
-def kinetic_energy(scene):
+def kinetic_energy(scene: Scene) -> float:
     check_scene(scene, state=True)
     nm = scene.n_mobile
     m = scene.mass[:nm]

@@ -16,7 +16,7 @@ that each LP restarts (primal simplex) from the previous optimal basis:
 
 ``simplex="clp"`` keeps HiGHS for the first LP only and restarts every later LP with CLP
 (:mod:`ncd.exact.clp_model`): on a 10^4-grain pile its primal simplex takes fewer iterations
-from the previous basis, in half the CPU (docs/solvers.md).
+from the previous basis (docs/solvers.md; the LP time of every pile: the bench page).
 """
 import time
 
@@ -62,9 +62,9 @@ class ExactSet:
             return self._minimize_clp(c, t0)
         self.highs.changeColsCost(self.n, self._cols, self._Tt @ c * self.scale)
         if self._last is None:
-            # no basis yet: interior point and crossover to a vertex (at 10^4 grains ~40 s,
-            # where primal simplex from the slack basis takes over ten minutes), then primal
-            # simplex from that basis for every later LP
+            # no basis yet: interior point and crossover to a vertex (on a large pile, primal
+            # simplex from the slack basis would pivot far longer to its first vertex), then
+            # primal simplex from that basis for every later LP
             self.highs.setOptionValue("solver", "ipm")
             self.highs.run()
             self.highs.setOptionValue("solver", "simplex")
@@ -110,8 +110,8 @@ class ExactSet:
         """An LP vertex ``r`` (forces) made exact: the Coulomb rows it meets within
         ``active_tol`` (scaled) and the equilibrium equations solved together by the
         minimum-norm correction (iterated Tikhonov on ``[[I, K^T], [K, -eps I]]``, one
-        sparse LU), which removes the LP's feasibility-tolerance residue (HiGHS: ~1e-8
-        of the force scale)."""
+        sparse LU), which removes the residue that the LP's feasibility tolerance leaves
+        on the equations."""
         x = np.asarray(r, float) / self.scale
         G, A = self.fp.G, self.fp.A_eq
         act = (G @ x) >= -active_tol

@@ -1,10 +1,12 @@
-"""A ∩ C by an interior point with dual certificates: angle ranges of a 10^4-grain pile in seconds.
+"""A ∩ C by an interior point with dual certificates: the angle ranges of a 10^4-grain pile.
 
-The simplex of :class:`ncd.exact.exact_set.ExactSet` pays milliseconds per pivot on the
-3 10^4 equilibrium rows of a 10^4-grain pile, and a central cut's LPs take 10^4 pivots
-each (docs/solvers.md).  An interior point (Clarabel, sparse LDL^T of the KKT system)
-solves the same LP in about 50 iterations whatever the cost vector.  Its point is not a
-vertex, so every value is bracketed instead, by weak duality:
+The simplex of :class:`ncd.exact.exact_set.ExactSet` pays for every pivot on the
+3 10^4 equilibrium rows of a 10^4-grain pile, and the LPs of a central cut, whose optima
+rearrange the forces of much of the pile, take many pivots each from the previous basis
+(docs/solvers.md).  An interior point (Clarabel, sparse LDL^T of the KKT system) solves
+the same LP in a number of iterations that hardly depends on the cost vector, with no
+basis to carry.  Its point is not a vertex, so every value is bracketed instead, by weak
+duality:
 
 * the primal point, a force state of A ∩ C (equilibrium to round-off, Coulomb exact in
   the sector columns of :func:`ncd.solver.cone.cone_columns`), gives a value attained;
@@ -13,8 +15,8 @@ vertex, so every value is bracketed instead, by weak duality:
   certified bound on ``sum z`` over A ∩ C (:meth:`InteriorSet.total_bound`, the same
   inequality applied to ``max sum z``).
 
-Where the dual residual times ``S`` (about 2 10^5 times the largest grain weight on a
-10^4-grain pile) is too coarse, one more LP bounds ``max residual . z`` over A ∩ C itself
+Where the dual residual times ``S`` (the pile's forces summed: many times the largest grain
+weight on a large pile) is too coarse, one more LP bounds ``max residual . z`` over A ∩ C itself
 (:meth:`InteriorSet._residual_cost`).
 
 An angle range (Moreau 2005, section 5: the direction of a cut resultant) is a
@@ -36,7 +38,7 @@ from ncd.exact.polytope import ForcePolytope, PolytopeError
 from ncd.solver.cone import cone_columns
 
 GAP_TOL = 1e-13          # Clarabel's absolute and relative duality gap: the dual residual, times the
-                         # bound on the forces, is what a certified end loses (1e-10: up to 1e-5 degree)
+                         # bound on the forces, is what a certified end loses, hence a tight gap
 BOUND_DEG = 1e-6         # an end whose bound (max residual times S) is larger pays one more LP for a tighter one
 FEAS_TOL = 1e-10         # Clarabel's feasibility tolerance (the primal point is corrected to round-off)
 UNIT = np.finfo(float).eps / 2     # unit round-off: the first-order error bounds of A^T y and y . b
@@ -204,7 +206,7 @@ class InteriorSet:
             p_min = float(alpha @ x)
             value, res = self._dual_value(y, self.b), self._dual_residual(alpha, self.A, y)
             p_lo = value - float(res.max()) * self.total_bound()
-            if p_lo < 0.99 * p_min:                 # the residual times S costs more than 1 %: bound it by an LP
+            if p_lo < 0.99 * p_min:                 # the residual times S costs over a hundredth: bound it by an LP
                 p_lo = max(p_lo, value - self._residual_cost(res))
             p_min *= norm
         if not p_lo * norm > 1e-9 * self.scale:

@@ -2,7 +2,7 @@
 polygon of a 2-D projection from support queries (:func:`support_polygon`).
 
 Used by :mod:`ncd.exact.polytope` (projections of A ∩ C on a contact's force plane) and
-by the figures' exact sets (:mod:`ncd.figures.pile_exact`).  Vertices are
+by the figures' exact sets (:mod:`ncd.figures.fig4_pile.exact`).  Vertices are
 counter-clockwise ``(n, 2)`` arrays.
 """
 import numpy as np

@@ -173,7 +173,7 @@ class ForcePolytope:
         Coulomb rows that no point of ``A ∩ C`` satisfies strictly (implicit
         equalities, e.g. a contact forced to slide or to carry no force) are
         moved to the equalities.  ``implicit`` (bool per row of ``G``), when known
-        (e.g. from :func:`ncd.figures.governing_exact.implicit_rows`), starts the search,
+        (e.g. from :func:`ncd.figures.fig5_governing.exact.implicit_rows`), starts the search,
         which then needs one LP when it is complete.  Returns ``(x0, Z, Gz, b, implicit)``
         in scaled units.
         """

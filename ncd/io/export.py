@@ -6,7 +6,7 @@ Input: a dataset with a ``frame`` dimension holding, per frame, the discs
 ``<p>line_y0``, ``<p>line_x1``, ``<p>line_y1``, ``<p>force_n``, ``<p>force_t`` over a
 padded contact dimension, NaN where absent), with ``<p>`` a prefix (``frame_`` in
 fig2's trajectory), and ``radius`` over ``disc``.  The construction files of Figure 4
-(:mod:`ncd.scenes.construction`) name the same quantities ``frame_x``, ``frame_y``,
+(:mod:`ncd.shared.construction`) name the same quantities ``frame_x``, ``frame_y``,
 ``frame_vx``, ``frame_vy``, ``frame_spin`` and ``frame_radius`` (``frame`` x ``disc``, NaN
 for a grain not yet poured: such discs are left out of the frame), with the fixed ground
 discs in ``ground_x``, ``ground_y``, ``ground_radius``.

@@ -157,10 +157,10 @@ KNOWN = {
     "limits_distance_velocity": ("1", "distance between the references of two inits (velocity)"),
     "reference": ("1", "reference value of the quantity"), "value": ("1", "value of the quantity"),
     "work": ("1", "CD: sum of sweeps x contacts; MD: steps x candidate pairs"),
-    # the ensembles of piles (ncd.figures.history_analysis)
+    # the ensembles of piles (ncd.figures.fig4_history.analysis)
     "history": ("1", "construction history of the pile (point source or rain)"),
     "pile": ("1", "pile (ensemble member) index"), "flank": ("1", "flank of the pile (left or right)"),
-    # the benchmark suite (ncd.studies.bench, results/bench/*.nc)
+    # the benchmark suite (ncd.studies.bench.solver, results/bench/*.nc)
     "size": ("1", "discs of the benchmark packing"), "threads": ("1", "threads of the ensemble run"),
     "speedup": ("1", "wall time on one thread over wall time on this many threads"),
     "same_results": ("1", "outputs identical to the one-thread run, bit for bit", FLAG),

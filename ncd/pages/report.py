@@ -1,7 +1,7 @@
 """The reproduction page ``results/index.html``: every claim of the paper, section by section.
 
 The claims and the functions that judge them are in :mod:`ncd.pages.claims`; a figure's
-page prints the same :class:`~ncd.core.verdict.Verdict` for the same claim, and each row
+page prints the same :class:`~ncd.shared.verdict.Verdict` for the same claim, and each row
 links to that block (``html/<figure>.html#claim-<id>``) and to the data files it read.
 A claim no figure measures is a *not tested* row with the reason; a missing file gives
 *not computed*, never a crash, so the page builds while figures change.  Figures
@@ -14,9 +14,10 @@ from pathlib import Path
 
 import yaml
 
-from ncd.core.verdict import BEYOND, DIFFERS, NOT_COMPUTED, NOT_TESTED, REPRODUCED
 from ncd.io.netcdf import git_commit, versions
 from ncd.pages.claims import CLAIMS, verdicts
+from ncd.pages.registry import JUDGES_BY_FIGURE
+from ncd.shared.verdict import BEYOND, DIFFERS, NOT_COMPUTED, NOT_TESTED, REPRODUCED
 
 
 def run_times(results, figure):
@@ -66,7 +67,7 @@ def section_of(claim):
 
 def claim_rows(results, claims=CLAIMS):
     """``[(claim, figure, Verdict)]``: one row per claim and figure judging it."""
-    return [(c, fig, v) for c in claims for fig, v in verdicts(c["id"], results)]
+    return [(c, fig, v) for c in claims for fig, v in verdicts(c["id"], results, JUDGES_BY_FIGURE)]
 
 
 def build_page(results, figures, config, claims=CLAIMS):

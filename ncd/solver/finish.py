@@ -11,7 +11,7 @@ that it stays on the solution NLGS approaches instead of jumping to another one 
 indeterminate problem.  An empty polyhedron near a solution falls back on the states
 at rest (:func:`rest_status`).  :func:`check_solution` checks a solution
 componentwise; :func:`project_statuses` (minimum-norm point of a status pattern's
-affine set) serves the census of :mod:`ncd.figures.census`.  Trade-offs: docs/solvers.md.
+affine set) serves the census of :mod:`ncd.figures.fig2_slope.census`.  Trade-offs: docs/solvers.md.
 """
 import logging
 

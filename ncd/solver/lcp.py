@@ -35,7 +35,7 @@ MAX_ENTRY = 1e150              # |M|, |q| at most: products of two entries stay 
 MAX_COVERING_RATIO = 1e12      # largest / smallest covering entry
 
 
-@njit(cache=True, nogil=True)    # no GIL: several runs side by side on threads (ncd.figures.census)
+@njit(cache=True, nogil=True)    # no GIL: several runs side by side on threads (ncd.figures.fig2_slope.census)
 def _lemke(M, q, d, max_pivots, tol):
     """Lemke's method on the tableau ``[I, -M, -d | q]``; returns ``(basis, status, pivots)``.
 

@@ -11,15 +11,19 @@ problems).  This module composes the variants chosen by
 chunked runs with an observable (:mod:`ncd.solver.convergence`) and the active-set
 finishing stage (:mod:`ncd.solver.finish`); none of them imports it back.
 """
+from __future__ import annotations
+
+from collections.abc import Callable
 
 import numpy as np
 import scipy.sparse as sp
+from numpy.typing import ArrayLike
 
 from ncd.core import validate
-from ncd.core.contacts import check_contacts, check_disc_blocks, delassus_blocks, local_velocity
+from ncd.core.contacts import Contacts, check_contacts, check_disc_blocks, delassus_blocks, local_velocity
 from ncd.core.errors import InputError
 from ncd.core.jit import njit
-from ncd.core.model import check_scene
+from ncd.core.model import Scene, check_scene
 from ncd.core.validate import array, impulse_guess, per_item, permutation, shape_of, show, sparse_matrix
 from ncd.solver.anderson import driver
 from ncd.solver.convergence import run_nlgs
@@ -29,10 +33,15 @@ from ncd.solver.local_exact import LocalExact
 from ncd.solver.pack import apply_all, pack_problem
 from ncd.solver.settings import NLGSResult, SolverSettings, check_settings_arg
 
+# ``observe(impulse, vel, spin) -> 1-D array``: a figure's observable (:mod:`ncd.solver.convergence`)
+Observer = Callable[[np.ndarray, np.ndarray, np.ndarray], ArrayLike]
+# ``(W, H, M^-1)`` of :func:`ncd.solver.finish.global_delassus`
+Delassus = tuple[sp.spmatrix, sp.spmatrix, np.ndarray]
+
 # ------------------------------------------------------------ entry points
 
 
-def restitution_bias(contacts, U_initial):
+def restitution_bias(contacts: Contacts, U_initial: np.ndarray) -> np.ndarray:
     """``e * U_i`` per component, for approaching contacts only (``U_i,n < 0``).
 
     The law is imposed on Moreau's weighted mean ``(U_f + e U_i) / (1 + e)``;
@@ -54,8 +63,11 @@ def _restitution_bias(e_n, e_t, U_initial):
 
 
 @validate.finite_output
-def solve_discs(scene, contacts, vel, spin, guess=None, review_order=None,
-                settings=SolverSettings(), bias=None, W=None, observe=None, check=True, delassus=None):
+def solve_discs(scene: Scene, contacts: Contacts, vel: np.ndarray, spin: np.ndarray,
+                guess: ArrayLike | None = None, review_order: ArrayLike | None = None,
+                settings: SolverSettings = SolverSettings(), bias: ArrayLike | None = None,
+                W: np.ndarray | None = None, observe: Observer | None = None, check: bool = True,
+                delassus: Delassus | None = None) -> NLGSResult:
     """Solve the core problem of one step by NLGS in disc form.
 
     ``vel, spin`` hold the free velocities on entry and the end-of-step
@@ -110,7 +122,8 @@ def solve_discs(scene, contacts, vel, spin, guess=None, review_order=None,
 
 
 @validate.finite_output
-def solve_local(W, q, mu, guess=None, review_order=None, settings=SolverSettings()):
+def solve_local(W: ArrayLike | sp.spmatrix, q: ArrayLike, mu: float | ArrayLike, guess: ArrayLike | None = None,
+                review_order: ArrayLike | None = None, settings: SolverSettings = SolverSettings()) -> NLGSResult:
     """NLGS on a 2-D frictional contact problem in local form.
 
     Find ``s`` (n, 2) with ``U = W s + q`` and the Coulomb law at each contact.

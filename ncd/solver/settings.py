@@ -4,6 +4,8 @@ A :class:`SolverSettings` is checked once, when it is built (``__post_init__``),
 that every entry point can trust an instance of the exact type (:func:`check_settings_arg`)
 and the kernels receive plain floats and ints.
 """
+from __future__ import annotations
+
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -46,10 +48,10 @@ class SolverSettings:
     accel_memory: int = 20
     local_exact: bool = False
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         check_solver_settings(self)    # InputError naming the field
 
-    def as_attrs(self):
+    def as_attrs(self) -> dict[str, float | int | str]:
         return {f"solver_{k}": int(v) if isinstance(v, bool) else v for k, v in asdict(self).items()}
 
 
@@ -69,15 +71,15 @@ class NLGSResult:
     local_solves: int = 0                   # local exact solves (ncd.solver.local_exact; 0: none)
 
     @property
-    def impulse_n(self):
+    def impulse_n(self) -> np.ndarray:
         return self.impulse[:, 0]
 
     @property
-    def impulse_t(self):
+    def impulse_t(self) -> np.ndarray:
         return self.impulse[:, 1]
 
 
-def check_solver_settings(settings, name="settings"):
+def check_solver_settings(settings: SolverSettings, name: str = "settings") -> SolverSettings:
     """Field checks of :class:`SolverSettings` (run by its ``__post_init__``). Values are
     stored back as plain float / int (frozen dataclass: ``object.__setattr__``), so that
     later checks, kernels and netCDF attributes see one type whatever the caller passed."""
@@ -102,7 +104,7 @@ def check_solver_settings(settings, name="settings"):
     return settings
 
 
-def check_settings_arg(settings, name="settings"):
+def check_settings_arg(settings: SolverSettings, name: str = "settings") -> SolverSettings:
     """A :class:`SolverSettings` argument. An instance of the exact type was checked when
     it was built (and is frozen); a subclass's instance is checked again."""
     if type(settings) is not SolverSettings:

@@ -16,7 +16,10 @@ The error measure is the natural map with De Saxce's modified velocity
 ``U~ = (U_n + mu |U_t|, U_t)``, ``F(r) = r - proj_K(r - rho U~)``, which vanishes
 exactly at solutions (``rho = 1 / W_nn`` makes it an impulse).
 """
+from __future__ import annotations
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ncd.core import validate
 from ncd.core.errors import InputError, SimulationError
@@ -80,7 +83,7 @@ def natural_map_sq(rn, rt, un, ut, mu, rho):
     return (rn - pn) ** 2 + (rt - pt) ** 2
 
 
-def solve_single_contact_py(W, q, mu):
+def solve_single_contact_py(W: ArrayLike, q: ArrayLike, mu: float) -> tuple[np.ndarray, int]:
     """Convenience wrapper: ``W`` (2, 2), ``q`` (2,) -> (r, status)."""
     W, q, mu = check_single_contact(W, q, mu)
     W = np.asarray(W, dtype=float)
@@ -89,7 +92,7 @@ def solve_single_contact_py(W, q, mu):
     return np.array([rn, rt]), int(status)
 
 
-def project_cone_py(zn, zt, mu):
+def project_cone_py(zn: float, zt: float, mu: float) -> tuple[float, float]:
     """:func:`project_cone` with its arguments checked: the public ``ncd.project_cone``."""
     pn, pt = project_cone(validate.real("zn", zn), validate.real("zt", zt), validate.real("mu", mu, 0.0))
     if not (np.isfinite(pn) and np.isfinite(pt)):
@@ -97,7 +100,7 @@ def project_cone_py(zn, zt, mu):
     return pn, pt
 
 
-def check_single_contact(W, q, mu):
+def check_single_contact(W: ArrayLike, q: ArrayLike, mu: float) -> tuple[np.ndarray, np.ndarray, float]:
     """Arguments of :func:`ncd.solve_single_contact_py`: a (2, 2) block positive
     definite as in the module docstring, ``q`` (2,), ``mu >= 0``; all finite."""
     W = array("W", W, (2, 2))

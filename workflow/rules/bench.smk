@@ -20,7 +20,7 @@ BENCH_THREADS = 2
 
 rule bench_core:
     input:
-        figure_code(FIGB),
+        code=code_of("bench_core"),
     output:
         "results/bench/core.nc",
     threads: BENCH_THREADS
@@ -38,7 +38,7 @@ rule bench_core:
 
 rule bench_sweeps:
     input:
-        figure_code(FIGB),
+        code=code_of("bench_sweeps"),
     output:
         "results/bench/sweeps.nc",
     threads: BENCH_THREADS
@@ -56,9 +56,9 @@ rule bench_sweeps:
 
 rule bench_tolerance:
     input:
-        figure_code(FIGB),
         construction="results/fig4_pile/construction.nc",
         trajectory="results/fig2_slope/trajectory.nc",
+        code=code_of("bench_tolerance"),
     output:
         packings="results/bench/tolerance.nc",
         problems="results/bench/tolerance_problems.nc",
@@ -79,7 +79,7 @@ rule bench_tolerance:
 
 rule bench_ensemble:
     input:
-        figure_code(FIGB),
+        code=code_of("bench_ensemble"),
     output:
         "results/bench/ensemble.nc",
     threads: BENCH_THREADS
@@ -97,7 +97,7 @@ rule bench_ensemble:
 
 rule bench_peer:
     input:
-        figure_code(FIGB),
+        code=code_of("bench_peer"),
     output:
         "results/bench/peer.nc",
     threads: BENCH_THREADS
@@ -117,6 +117,7 @@ rule bench_rules:
     """The wall time of every rule of the figures (their benchmark files, after their run)."""
     input:
         [figure_targets(f) for f in FIGURES],
+        code=code_of("bench_rules"),
     output:
         "results/bench/rules.nc",
     params:
@@ -137,6 +138,7 @@ rule bench_exact:
     and those of the size study when it has run)."""
     input:
         figure_targets("fig4_history"),
+        code=code_of("bench_exact"),
     output:
         "results/bench/exact_sets.nc",
     params:
@@ -157,6 +159,7 @@ rule bench_dag:
     input:
         [figure_targets(f) for f in FIGURES],
         "results/index.html",
+        code=code_of("bench_dag"),
     output:
         "results/bench/dag.nc",
     params:
@@ -185,8 +188,7 @@ rule bench_notebook:
         exact_sets="results/bench/exact_sets.nc",
         notebook=notebook_file("bench"),
         notebook_py=notebook_file("bench", "py"),
-        page=page_modules(FIGB),
-        pages=page_sources("notebook"),
+        code=notebook_code("bench"),
     output:
         png=figure_output("bench", "png"),
         pdf=figure_output("bench", "pdf"),

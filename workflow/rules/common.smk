@@ -12,8 +12,8 @@ import glob
 import os
 from pathlib import Path
 
-from ncd.figures import FIGURE_MODULES
 from ncd.pipeline.config import check_config
+from ncd.pipeline.imports import closure
 
 ROOT = Path(workflow.basedir)
 # Every rule input and output is relative to the working directory, so that a moved or
@@ -45,42 +45,13 @@ ENSEMBLE_THREADS = 1
 # jobs fill the cores around them instead of delaying them to the end.
 PRIORITY = {"fig2_slope": 100, "fig4_pile": 50}
 
-# The sources a figure's computing rules depend on: the layers below the figures (kernels,
-# data, exact sets, dynamics, workflow glue and the shared scenes, ncd/__init__.py) and the
-# figure's own modules (ncd.figures.FIGURE_MODULES, the table the layer test reads too).
-# Editing a solver module reruns every figure, a figure's module that figure only, and a
-# page module (ncd/pages) only the page rules that list it (page_sources).
-LOWER_LAYERS = ("core", "io", "solver", "exact", "dynamics", "pipeline", "scenes")
-NCD_CORE = sorted([str(REL / "ncd" / "__init__.py")]
-                  + [str(REL / p.relative_to(ROOT)) for layer in LOWER_LAYERS
-                     for p in (ROOT / "ncd" / layer).glob("*.py")])
-STUDY_MODULES = {
-    "stability": ("stability.py", "scenes.py", "stability_page.py"),
-    "error_vs_runtime": ("work_precision.py", "scenes.py", "work_precision_page.py"),
-    "bench": ("bench.py", "peer.py", "finish_bench.py", "c_sweep.c", "bench_page.py"),
-}
-# the page modules a page rule reads (notebook helpers, the HTML renderer, the index page)
-# (a figure's page and the index print the claims of ncd/pages/claims.py: both read it)
-PAGE_MODULES = {"notebook": ("notebook.py", "claims.py", "paper_claims.yaml"), "render": ("render.py",),
-                "report": ("report.py", "claims.py", "paper_claims.yaml")}
-
-
-def ncd_sources(figure):
-    """Input files of a figure's computing rules: the lower layers and the figure's own modules
-    except its page modules (``*_page.py``: the figure, sentences and tables of its page)."""
-    if figure in FIGURE_MODULES:
-        own = ["figures/__init__.py"] + [f"figures/{m}.py" for m in FIGURE_MODULES[figure]]
-    else:
-        own = ["studies/__init__.py"] + [f"studies/{m}" for m in STUDY_MODULES[figure]]
-    return NCD_CORE + [str(REL / "ncd" / m) for m in own if not m.endswith("_page.py")]
-
-
-# One input stands for a set of sources: results/code/<name>.sha256, the SHA-256 of each file,
-# rebuilt (rule code_stamp) when one of them is newer.  A computing rule lists that stamp instead
-# of its ~55 source files: Snakemake stats every input of every ready job each time it picks jobs;
-# the stamps took a third off the main process's CPU on the reduced DAG
-# (workflow/README.md).  Editing a source still reruns exactly the rules whose set holds it (the
-# stamp is newer than their outputs).
+# The code a rule runs: the import closure of its script (or notebook) inside ncd/, read from
+# the imports (ncd.pipeline.imports), so that no list of modules is kept by hand.  An edit of a
+# figure's computation reruns the rules whose scripts import it, an edit of its plots.py or
+# page.py only its notebook (and the pages after it), an edit of a lower layer every rule
+# above it.  One input stands for the set: results/code/<name>.sha256, the SHA-256 of each
+# file, rebuilt (rule code_stamp) when one of them is newer; Snakemake stats every input of
+# every ready job each time it picks jobs, so one stamp per rule keeps that cheap.
 CODE_SETS = {}
 
 
@@ -92,23 +63,16 @@ def code(name, files):
     return f"results/code/{name}.sha256"
 
 
-def figure_code(figure):
-    """The stamp of a figure's computing sources (:func:`ncd_sources`)."""
-    return code(figure, ncd_sources(figure))
+def code_of(script):
+    """The stamp of ``workflow/scripts/<script>.py`` and the ncd files it imports."""
+    path = REL / "workflow" / "scripts" / f"{script}.py"
+    return code(script, [str(path)] + closure([path], REL / "ncd"))
 
 
-def page_modules(figure):
-    """The page modules of a figure (``*_page.py`` among its modules): inputs of its notebook rule."""
-    if figure in FIGURE_MODULES:
-        own = [f"figures/{m}.py" for m in FIGURE_MODULES[figure]]
-    else:
-        own = [f"studies/{m}" for m in STUDY_MODULES[figure]]
-    return [str(REL / "ncd" / m) for m in own if m.endswith("_page.py")]
-
-
-def page_sources(kind):
-    """The page modules of a page rule (never inputs of a computing rule)."""
-    return [str(REL / "ncd" / "pages" / m) for m in ("__init__.py",) + PAGE_MODULES[kind]]
+def notebook_code(figure):
+    """The stamp of the ncd files a figure's notebook imports (read from its jupytext pair,
+    ``notebooks/<figure>.py``; the notebook files themselves are inputs of their own)."""
+    return code(f"{figure}_notebook", closure([REL / "notebooks" / f"{figure}.py"], REL / "ncd"))
 
 
 def section(figure):

@@ -7,7 +7,7 @@ CFG = section(FIG)
 rule error_vs_runtime_nlgs:
     """Build each state and run every NLGS setting on its next step."""
     input:
-        figure_code(FIG),
+        code=code_of("error_vs_runtime_nlgs"),
     output:
         "results/error_vs_runtime/nlgs.nc",
     params:
@@ -25,7 +25,7 @@ rule error_vs_runtime_nlgs:
 rule error_vs_runtime_integration:
     """CD over h and MD over h and stiffness, for each observable."""
     input:
-        figure_code(FIG),
+        code=code_of("error_vs_runtime_integration"),
     output:
         "results/error_vs_runtime/integration.nc",
     params:
@@ -44,10 +44,9 @@ rule error_vs_runtime_notebook:
     input:
         nlgs="results/error_vs_runtime/nlgs.nc",
         integration="results/error_vs_runtime/integration.nc",
-        page=page_modules(FIG),
         notebook=notebook_file("error_vs_runtime"),
         notebook_py=notebook_file("error_vs_runtime", "py"),
-        pages=page_sources("notebook"),
+        code=notebook_code("error_vs_runtime"),
     output:
         png=figure_output("error_vs_runtime", "png"),
         pdf=figure_output("error_vs_runtime", "pdf"),

@@ -19,6 +19,7 @@ if "fig4_history" in FIGURES:
 rule export_frames:
     input:
         lambda w: EXPORTS[w.figure][0],
+        code=code_of("export_frames"),
     output:
         vtk=directory("results/{figure}/vtk"),
         animation=f"results/figures/{{figure}}.{ANIM_EXT}",

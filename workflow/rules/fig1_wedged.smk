@@ -6,7 +6,7 @@ CFG = section(FIG)
 rule fig1_wedged_explore:
     """One shard of the one-step exploration ensemble (random and zero initial guesses)."""
     input:
-        figure_code(FIG),
+        code=code_of("fig1_explore"),
     output:
         temp("results/fig1_wedged/shards/{name}_{shard}-of-{n}.nc"),
     wildcard_constraints:
@@ -28,7 +28,8 @@ rule fig1_wedged_explore:
 
 rule fig1_wedged_merge:
     input:
-        shard_files(FIG, "ensemble", CFG["ensemble"]["shards"]),
+        shards=shard_files(FIG, "ensemble", CFG["ensemble"]["shards"]),
+        code=code_of("merge_shards"),
     output:
         "results/fig1_wedged/ensemble.nc",
     params:
@@ -46,7 +47,7 @@ rule fig1_wedged_merge:
 rule fig1_wedged_simulate:
     """The two evolutions (zero guess at every step; wedged first guess then warm starts)."""
     input:
-        figure_code(FIG),
+        code=code_of("fig1_simulate"),
     output:
         "results/fig1_wedged/evolutions.nc",
     params:
@@ -65,7 +66,7 @@ rule fig1_wedged_simulate:
 rule fig1_wedged_sweep:
     """Fraction of wedged outcomes against the friction angle."""
     input:
-        figure_code(FIG),
+        code=code_of("fig1_sweep"),
     output:
         "results/fig1_wedged/sweep.nc",
     params:
@@ -86,10 +87,9 @@ rule fig1_wedged_notebook:
         ensemble="results/fig1_wedged/ensemble.nc",
         evolutions="results/fig1_wedged/evolutions.nc",
         sweep="results/fig1_wedged/sweep.nc",
-        page=page_modules(FIG),
         notebook=notebook_file("fig1_wedged"),
         notebook_py=notebook_file("fig1_wedged", "py"),
-        pages=page_sources("notebook"),
+        code=notebook_code("fig1_wedged"),
     output:
         png=figure_output("fig1_wedged", "png"),
         pdf=figure_output("fig1_wedged", "pdf"),

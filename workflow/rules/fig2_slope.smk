@@ -20,7 +20,7 @@ CFG2_EXP = {k: CFG2[k] for k in ("scene", "flow", "explore")}
 rule fig2_slope_simulate:
     priority: PRIORITY["fig2_slope"]
     input:
-        figure_code(FIG2),
+        code=code_of("fig2_slope_simulate"),
     output:
         f"{F2}/trajectory.nc",
     params:
@@ -38,8 +38,8 @@ rule fig2_slope_simulate:
 rule fig2_slope_explore:
     priority: PRIORITY["fig2_slope"]
     input:
-        figure_code(FIG2),
         trajectory=f"{F2}/trajectory.nc",
+        code=code_of("fig2_slope_explore"),
     output:
         temp(f"{F2}/shards/ensemble_{{shard}}-of-{{n}}.nc"),
     wildcard_constraints:
@@ -61,7 +61,8 @@ rule fig2_slope_explore:
 rule fig2_slope_merge:
     priority: PRIORITY["fig2_slope"]
     input:
-        shard_files(FIG2, "ensemble", CFG2["explore"]["shards"]),
+        shards=shard_files(FIG2, "ensemble", CFG2["explore"]["shards"]),
+        code=code_of("merge_shards"),
     output:
         f"{F2}/ensemble.nc",
     params:
@@ -79,9 +80,9 @@ rule fig2_slope_merge:
 rule fig2_slope_analyse:
     priority: PRIORITY["fig2_slope"]
     input:
-        figure_code(FIG2),
         trajectory=f"{F2}/trajectory.nc",
         ensemble=f"{F2}/ensemble.nc",
+        code=code_of("fig2_slope_analyse"),
     output:
         f"{F2}/measures.nc",
     params:
@@ -99,10 +100,10 @@ rule fig2_slope_analyse:
 rule fig2_slope_census:
     priority: PRIORITY["fig2_slope"]
     input:
-        figure_code(FIG2),
         trajectory=f"{F2}/trajectory.nc",
         ensemble=f"{F2}/ensemble.nc",
         measures=f"{F2}/measures.nc",
+        code=code_of("fig2_slope_census"),
     output:
         f"{F2}/census.nc",
     # its random-guess NLGS runs, Lemke runs, status projections and perturbed restarts run
@@ -127,10 +128,9 @@ rule fig2_slope_notebook:
         ensemble=f"{F2}/ensemble.nc",
         measures=f"{F2}/measures.nc",
         census=f"{F2}/census.nc",
-        page=page_modules(FIG2),
         notebook=notebook_file(FIG2),
         notebook_py=notebook_file(FIG2, "py"),
-        pages=page_sources("notebook"),
+        code=notebook_code("fig2_slope"),
     output:
         png=figure_output(FIG2, "png"),
         pdf=figure_output(FIG2, "pdf"),

@@ -6,19 +6,16 @@
 #   projection  LP projections of A ∩ C on each contact   -> projection.nc
 #   uniform     hit-and-run sample of A ∩ C               -> uniform.nc
 #   notebook    notebooks/fig3_equilibrium.ipynb (figure, table and sentences:
-#               ncd/figures/equilibrium_plots.py)          -> results/figures/fig3_equilibrium.png|pdf
+#               ncd/figures/fig3_equilibrium/plots.py)          -> results/figures/fig3_equilibrium.png|pdf
 FIG = "fig3_equilibrium"
 CFG = section(FIG)
 F3 = f"results/{FIG}"
 F3_MODES = ("zero", "random", "warm")
-# the page's figure, table and sentences (equilibrium_plots.py, with faces.py) are read by the notebook only
-F3_PAGE = [str(REL / "ncd" / "figures" / m) for m in ("equilibrium_plots.py", "faces.py")]
-F3_SOURCES = [f for f in ncd_sources(FIG) if f not in F3_PAGE]
 
 
 rule fig3_equilibrium_simulate:
     input:
-        code(FIG, F3_SOURCES),
+        code=code_of("fig3_equilibrium_simulate"),
     output:
         f"{F3}/state.nc",
     params:
@@ -35,8 +32,8 @@ rule fig3_equilibrium_simulate:
 
 rule fig3_equilibrium_explore:
     input:
-        code(FIG, F3_SOURCES),
         state=f"{F3}/state.nc",
+        code=code_of("fig3_equilibrium_explore"),
     output:
         temp(f"{F3}/shards/{{name}}_{{shard}}-of-{{n}}.nc"),
     wildcard_constraints:
@@ -58,7 +55,8 @@ rule fig3_equilibrium_explore:
 
 rule fig3_equilibrium_merge:
     input:
-        [f for m in F3_MODES for f in shard_files(FIG, m, CFG["modes"][m]["shards"])],
+        shards=[f for m in F3_MODES for f in shard_files(FIG, m, CFG["modes"][m]["shards"])],
+        code=code_of("merge_shards"),
     output:
         f"{F3}/ensemble.nc",
     params:
@@ -75,8 +73,8 @@ rule fig3_equilibrium_merge:
 
 rule fig3_equilibrium_projection:
     input:
-        code(FIG, F3_SOURCES),
         state=f"{F3}/state.nc",
+        code=code_of("fig3_equilibrium_projection"),
     output:
         f"{F3}/projection.nc",
     params:
@@ -93,8 +91,8 @@ rule fig3_equilibrium_projection:
 
 rule fig3_equilibrium_uniform:
     input:
-        code(FIG, F3_SOURCES),
         state=f"{F3}/state.nc",
+        code=code_of("fig3_equilibrium_uniform"),
     output:
         f"{F3}/uniform.nc",
     params:
@@ -115,10 +113,9 @@ rule fig3_equilibrium_notebook:
         ensemble=f"{F3}/ensemble.nc",
         projection=f"{F3}/projection.nc",
         uniform=f"{F3}/uniform.nc",
-        plots=F3_PAGE,
         notebook=notebook_file(FIG),
         notebook_py=notebook_file(FIG, "py"),
-        pages=page_sources("notebook"),
+        code=notebook_code("fig3_equilibrium"),
     output:
         png=figure_output(FIG, "png"),
         pdf=figure_output(FIG, "pdf"),

@@ -17,8 +17,6 @@ BANK_EXACT = ["default"] + [f"{h}_{m:03d}" for h in ("point", "rain")
 
 BANK_HISTORY_PILES = f"{FH}/piles/n{NH}"
 BANK_PILES = piles_of(NH)
-# the computing rules do not depend on the plots and the claims (editing them reruns the notebook only)
-BANK_SOURCES = [f for f in ncd_sources(BANK_FIG) if not f.endswith(("bank_plots.py", "bank_claims.py"))]
 
 
 def bank_pile(name):
@@ -34,10 +32,10 @@ BANK_EXACT_CFG = {k: v for k, v in BANK_CFG.items() if k not in ("analysis", "ve
 
 rule fig4_bank_measure:
     input:
-        code(BANK_FIG, BANK_SOURCES),
         construction="results/fig4_pile/construction.nc",
         cuts="results/fig4_pile/cuts.nc",
         piles=BANK_PILES,
+        code=code_of("fig4_bank_measure"),
     output:
         f"{BANK_DIR}/measures.nc",
     params:
@@ -54,9 +52,9 @@ rule fig4_bank_measure:
 
 rule fig4_bank_exact:
     input:
-        code(BANK_FIG, BANK_SOURCES),
         pile=lambda w: bank_pile(w.pile),
         cuts=lambda w: "results/fig4_pile/cuts.nc" if w.pile == "default" else [],   # the default pile's fits
+        code=code_of("fig4_bank_exact"),
     output:
         f"{BANK_DIR}/exact/{{pile}}.nc",
     wildcard_constraints:
@@ -82,8 +80,7 @@ rule fig4_bank_notebook:
         cuts="results/fig4_pile/cuts.nc",
         notebook=notebook_file(BANK_FIG),
         notebook_py=notebook_file(BANK_FIG, "py"),
-        pages=page_sources("notebook"),
-        plots=[str(REL / "ncd" / "figures" / f"{m}.py") for m in ("bank_plots", "bank_claims")],
+        code=notebook_code("fig4_bank"),
     output:
         png=figure_output(BANK_FIG, "png"),
         pdf=figure_output(BANK_FIG, "pdf"),

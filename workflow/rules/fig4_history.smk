@@ -5,7 +5,7 @@
 #              removed at the end)                              -> piles/n<n>/<history>_<m>.nc
 #   exact      exact angle ranges over A ∩ C at the arching cuts of the first exact.piles
 #              members of each history (exact.solver: HiGHS's simplex, or Clarabel's
-#              interior point for 10^4 grains; ncd.figures.history_exact)
+#              interior point for 10^4 grains; ncd.figures.fig4_history.exact)
 #                                                                -> exact/n<n>/<history>_<m>.nc
 #   analyse    ground stress, dip, arching over the piles       -> analysis_n<n>.nc
 #   notebook   notebooks/fig4_history.ipynb                     -> results/figures/fig4_history.png|pdf
@@ -65,21 +65,14 @@ def exact_of(n):
             for m in range(min(c["exact"]["piles"], c["piles"]))]
 
 
-# the construction does not depend on the analysis, exact and plotting modules nor on the exact
-# layer ncd/exact (editing them reruns the exact ranges and the analysis only)
-FH_AFTER = ("history_analysis.py", "history_exact.py", "history_plots.py", "history_size.py", "pile_exact.py",
-            "pressure.py")
-FH_BUILD_SOURCES = [f for f in ncd_sources(FIGH) if not f.endswith(FH_AFTER) and Path(f).parent.name != "exact"]
 FH_PILES = piles_of(NH)
 FH_EXACT = exact_of(NH)
-# the exact ranges (A ∩ C by ncd.exact, through history_exact) do not depend on the plots
-FH_EXACT_SOURCES = [f for f in ncd_sources(FIGH) if not f.endswith(("history_plots.py", "history_size.py"))]
 
 
 rule fig4_history_construct:
     input:
-        code(f"{FIGH}_build", FH_BUILD_SOURCES),
         point=lambda w: [] if w.history == "point" else f"{FH}/piles/n{w.n}/point_{w.member}.nc",
+        code=code_of("fig4_history_construct"),
     output:
         f"{FH}/piles/n{{n}}/{{history}}_{{member}}.nc",
     wildcard_constraints:
@@ -101,8 +94,8 @@ rule fig4_history_construct:
 
 rule fig4_history_exact:
     input:
-        code(f"{FIGH}_exact", FH_EXACT_SOURCES),
         pile=f"{FH}/piles/n{{n}}/{{history}}_{{member}}.nc",
+        code=code_of("fig4_history_exact"),
     output:
         f"{FH}/exact/n{{n}}/{{history}}_{{member}}.nc",
     wildcard_constraints:
@@ -123,9 +116,9 @@ rule fig4_history_exact:
 
 rule fig4_history_analyse:
     input:
-        figure_code(FIGH),
         piles=lambda w: piles_of(w.n),
         exact=lambda w: exact_of(w.n),
+        code=code_of("fig4_history_analyse"),
     output:
         f"{FH}/analysis_n{{n}}.nc",
     wildcard_constraints:
@@ -147,10 +140,9 @@ rule fig4_history_notebook:
         analysis=f"{FH}/analysis_n{NH}.nc",
         point=f"{FH}/piles/n{NH}/point_000.nc",
         rain=f"{FH}/piles/n{NH}/rain_000.nc",
-        plots=str(REL / "ncd" / "figures" / "history_plots.py"),
         notebook=notebook_file(FIGH),
         notebook_py=notebook_file(FIGH, "py"),
-        pages=page_sources("notebook"),
+        code=notebook_code("fig4_history"),
     output:
         png=figure_output(FIGH, "png"),
         pdf=figure_output(FIGH, "pdf"),
@@ -176,10 +168,10 @@ FHS = "fig4_history_size"
 
 
 rule fig4_history_size_analyse:
-    """The analyses of every pile size side by side (ncd.figures.history_size)."""
+    """The analyses of every pile size side by side (ncd.figures.fig4_history.size)."""
     input:
-        figure_code(FIGH),
         analyses=[f"{FH}/analysis_n{n}.nc" for n in SIZES],
+        code=code_of("fig4_history_size"),
     output:
         f"{FH}/size.nc",
     params:
@@ -197,10 +189,9 @@ rule fig4_history_size_analyse:
 rule fig4_history_size_notebook:
     input:
         sizes=f"{FH}/size.nc",
-        plots=str(REL / "ncd" / "figures" / "history_size.py"),
         notebook=notebook_file(FHS),
         notebook_py=notebook_file(FHS, "py"),
-        pages=page_sources("notebook"),
+        code=notebook_code("fig4_history_size"),
     output:
         png=figure_output(FHS, "png"),
         pdf=figure_output(FHS, "pdf"),

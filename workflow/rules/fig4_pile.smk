@@ -7,7 +7,7 @@
 #   explore    zero-guess NLGS runs (random orders) of one shard of
 #              the ensemble or of the tolerance study               -> shards/<name>_<k>-of-<n>.nc
 #   merge      the shards, in member order                          -> ensemble.nc, tolerance.nc
-#   notebook   notebooks/fig4_pile.ipynb (figure and sentences: ncd/figures/pile_plots.py)
+#   notebook   notebooks/fig4_pile.ipynb (figure and sentences: ncd/figures/fig4_pile/plots.py)
 #                                                                   -> results/figures/fig4_pile.png|pdf
 FIG4 = "fig4_pile"
 CFG4 = section(FIG4)
@@ -19,15 +19,12 @@ CFG4_CUTS = {**CFG4_SIM, **{k: CFG4[k] for k in ("surface", "cut", "pressure")}}
 CFG4_EXACT = {**CFG4_CUTS, "exact": CFG4["exact"]}
 CFG4_EXP = {**CFG4_CUTS, **{k: CFG4[k] for k in ("ensemble", "tolerance_study")}}
 F4_SHARDS = {"ensemble": CFG4["ensemble"]["shards"], "tolerance": CFG4["tolerance_study"]["shards"]}
-# the page's figure and sentences (ncd/figures/pile_plots.py) are read by the notebook only
-F4_PLOTS = str(REL / "ncd" / "figures" / "pile_plots.py")
-F4_SOURCES = [f for f in ncd_sources(FIG4) if f != F4_PLOTS]
 
 
 rule fig4_pile_simulate:
     priority: PRIORITY["fig4_pile"]
     input:
-        code(FIG4, F4_SOURCES),
+        code=code_of("fig4_pile_simulate"),
     output:
         f"{F4}/construction.nc",
     params:
@@ -45,8 +42,8 @@ rule fig4_pile_simulate:
 rule fig4_pile_cuts:
     priority: PRIORITY["fig4_pile"]
     input:
-        code(FIG4, F4_SOURCES),
         construction=f"{F4}/construction.nc",
+        code=code_of("fig4_pile_cuts"),
     output:
         f"{F4}/cuts.nc",
     params:
@@ -64,9 +61,9 @@ rule fig4_pile_cuts:
 rule fig4_pile_exact:
     priority: PRIORITY["fig4_pile"]
     input:
-        code(FIG4, F4_SOURCES),
         construction=f"{F4}/construction.nc",
         cuts=f"{F4}/cuts.nc",
+        code=code_of("fig4_pile_exact"),
     output:
         f"{F4}/exact.nc",
     params:
@@ -84,9 +81,9 @@ rule fig4_pile_exact:
 rule fig4_pile_explore:
     priority: PRIORITY["fig4_pile"]
     input:
-        code(FIG4, F4_SOURCES),
         construction=f"{F4}/construction.nc",
         cuts=f"{F4}/cuts.nc",
+        code=code_of("fig4_pile_explore"),
     output:
         temp(f"{F4}/shards/{{name}}_{{shard}}-of-{{n}}.nc"),
     wildcard_constraints:
@@ -109,7 +106,8 @@ rule fig4_pile_explore:
 rule fig4_pile_merge:
     priority: PRIORITY["fig4_pile"]
     input:
-        lambda w: shard_files(FIG4, w.name, F4_SHARDS[w.name]),
+        shards=lambda w: shard_files(FIG4, w.name, F4_SHARDS[w.name]),
+        code=code_of("merge_shards"),
     output:
         f"{F4}/{{name}}.nc",
     wildcard_constraints:
@@ -134,10 +132,9 @@ rule fig4_pile_notebook:
         ensemble=f"{F4}/ensemble.nc",
         tolerance=f"{F4}/tolerance.nc",
         exact=f"{F4}/exact.nc",
-        plots=F4_PLOTS,
         notebook=notebook_file(FIG4),
         notebook_py=notebook_file(FIG4, "py"),
-        pages=page_sources("notebook"),
+        code=notebook_code("fig4_pile"),
     output:
         png=figure_output(FIG4, "png"),
         pdf=figure_output(FIG4, "pdf"),

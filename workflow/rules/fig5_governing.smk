@@ -13,7 +13,7 @@ F5 = f"results/{FIG}"
 
 rule fig5_governing_pack:
     input:
-        figure_code(FIG),
+        code=code_of("fig5_governing_pack"),
     output:
         temp(f"{F5}/shards/packs_{{shard}}-of-{{n}}.nc"),
     wildcard_constraints:
@@ -33,8 +33,8 @@ rule fig5_governing_pack:
 
 rule fig5_governing_analyse:
     input:
-        figure_code(FIG),
         packs=shard_files(FIG, "packs", CFG["shards"]),
+        code=code_of("fig5_governing_analyse"),
     output:
         temp(f"{F5}/shards/analyses_{{shard}}-of-{{n}}.nc"),
     wildcard_constraints:
@@ -56,6 +56,7 @@ rule fig5_governing_merge:
     input:
         packs=shard_files(FIG, "packs", CFG["shards"]),
         analyses=shard_files(FIG, "analyses", CFG["shards"]),
+        code=code_of("fig5_governing_merge"),
     output:
         f"{F5}/packings.nc",
     log:
@@ -74,7 +75,7 @@ rule fig5_governing_notebook:
         flows=f"{F5}/flows.nc",
         notebook=notebook_file(FIG),
         notebook_py=notebook_file(FIG, "py"),
-        pages=page_sources("notebook"),
+        code=notebook_code("fig5_governing"),
     output:
         # the report's caption is the finding, written by the notebook from the data
         png=report(f"results/figures/{FIG}.png", caption=os.path.abspath(f"{F5}/caption.rst"), category=FIG,
@@ -104,7 +105,7 @@ rule fig5_governing:
 #   deposit   one deposit per seed (at the base mu), shared by every setting -> shards/deposit_seed<s>.nc
 #   flow      one flow per (setting, seed), scanned                       -> shards/flow_<i>_seed<s>.nc
 #   flows     every flow                                                  -> flows.nc
-from ncd.figures import governing_flow as _gflow
+from ncd.figures.fig5_governing import flow as _gflow
 
 FLOWS = CFG["flows"]
 FLOW_CFG = {"scene": section("fig2_slope")["scene"], "deposit": section("fig2_slope")["deposit"],
@@ -117,7 +118,7 @@ FLOW_SHARDS = [f"{F5}/shards/flow_{i}_seed{s}.nc" for i in range(len(FLOW_MU)) f
 
 rule fig5_governing_deposit:
     input:
-        figure_code(FIG),
+        code=code_of("fig5_governing_deposit"),
     output:
         temp(f"{F5}/shards/deposit_seed{{s}}.nc"),
     wildcard_constraints:
@@ -136,8 +137,8 @@ rule fig5_governing_deposit:
 
 rule fig5_governing_flow:
     input:
-        figure_code(FIG),
         deposit=f"{F5}/shards/deposit_seed{{s}}.nc",
+        code=code_of("fig5_governing_flow"),
     output:
         temp(f"{F5}/shards/flow_{{i}}_seed{{s}}.nc"),
     wildcard_constraints:
@@ -157,7 +158,8 @@ rule fig5_governing_flow:
 
 rule fig5_governing_flows:
     input:
-        FLOW_SHARDS,
+        shards=FLOW_SHARDS,
+        code=code_of("merge_shards"),
     output:
         f"{F5}/flows.nc",
     params:

@@ -7,6 +7,8 @@
 
 rule html_mathjax:
     """MathJax, copied beside the pages from the jupyter-server-mathjax package (maths offline)."""
+    input:
+        code=code_of("html_mathjax"),
     output:
         directory("results/html/mathjax"),
     log:
@@ -27,7 +29,7 @@ rule render_html:
     input:
         png="results/figures/{figure}.png",
         mathjax="results/html/mathjax",
-        render=page_sources("render"),
+        code=code_of("render_html"),
     output:
         html="results/html/{figure}.html",
     params:
@@ -47,6 +49,7 @@ rule thumbnail:
     """A small copy of a figure for the README (docs/thumbnails, committed)."""
     input:
         "results/figures/{figure}.png",
+        code=code_of("thumbnail"),
     output:
         "docs/thumbnails/{figure}.png",
     log:

@@ -7,7 +7,7 @@
 rule index:
     input:
         figures=[figure_targets(f) for f in FIGURES],
-        report=page_sources("report"),
+        code=code_of("index"),
     output:
         "results/index.html",
     params:

@@ -5,11 +5,12 @@ CFG = section(FIG)
 
 
 rule stability_simulate:
-    """The stability table: one row per (case, method, h)."""
+    """The stability table (one row per (case, method, h)) and one binary collision (restitution)."""
     input:
-        figure_code(FIG),
+        code=code_of("stability_simulate"),
     output:
-        "results/stability/table.nc",
+        table="results/stability/table.nc",
+        collision="results/stability/collision.nc",
     params:
         config=CFG,
     log:
@@ -25,10 +26,10 @@ rule stability_simulate:
 rule stability_notebook:
     input:
         table="results/stability/table.nc",
-        page=page_modules(FIG),
+        collision="results/stability/collision.nc",
         notebook=notebook_file("stability"),
         notebook_py=notebook_file("stability", "py"),
-        pages=page_sources("notebook"),
+        code=notebook_code("stability"),
     output:
         png=figure_output("stability", "png"),
         pdf=figure_output("stability", "pdf"),

@@ -2,10 +2,10 @@
 import glob
 
 from ncd.io.netcdf import write_dataset
-from ncd.pipeline.workflow import start
-from ncd.studies.bench import exact_costs
+from ncd.pipeline.jobs import start
+from ncd.studies.bench.runs import exact_costs
 
-log = start(snakemake)  # noqa: F821 (snakemake is injected)
-ds = exact_costs(glob.glob(snakemake.params.pattern))  # noqa: F821
+log = start(snakemake)  # snakemake is injected
+ds = exact_costs(glob.glob(snakemake.params.pattern))
 log.info("%d piles with exact ranges, %.0f s of LPs in all", ds.sizes["pile"], float(ds.lp_seconds.sum()))
-write_dataset(ds, snakemake.output[0])  # noqa: F821
+write_dataset(ds, snakemake.output[0])

@@ -1,10 +1,10 @@
 """ncd and pymunk side by side on the same poured pile."""
 from ncd.io.netcdf import write_dataset
-from ncd.pipeline.workflow import start
-from ncd.studies.bench import environment
-from ncd.studies.peer import compare
+from ncd.pipeline.jobs import start
+from ncd.studies.bench.peer import compare
+from ncd.studies.bench.solver import environment
 
-log = start(snakemake)  # noqa: F821 (snakemake is injected)
-ds = compare(snakemake.params.config, log)  # noqa: F821
+log = start(snakemake)  # snakemake is injected
+ds = compare(snakemake.params.config, log)
 ds.attrs.update(environment())
-write_dataset(ds, snakemake.output[0])  # noqa: F821
+write_dataset(ds, snakemake.output[0])

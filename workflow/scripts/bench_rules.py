@@ -2,12 +2,12 @@
 import glob
 
 from ncd.io.netcdf import write_dataset
-from ncd.pipeline.workflow import start
-from ncd.studies.bench import rule_times
+from ncd.pipeline.jobs import start
+from ncd.studies.bench.runs import rule_times
 
-log = start(snakemake)  # noqa: F821 (snakemake is injected)
-paths = [p for p in glob.glob(snakemake.params.pattern)  # noqa: F821
-         if p.split("/")[-2] in snakemake.params.figures]  # noqa: F821
+log = start(snakemake)  # snakemake is injected
+paths = [p for p in glob.glob(snakemake.params.pattern)
+         if p.split("/")[-2] in snakemake.params.figures]
 ds = rule_times(paths)
 log.info("%d rule benchmarks, %.0f s in all", ds.sizes["job"], float(ds.seconds.sum()))
-write_dataset(ds, snakemake.output[0])  # noqa: F821
+write_dataset(ds, snakemake.output[0])

@@ -1,10 +1,10 @@
 """Sweeps to a fixed tolerance against N (zero guess and warm start)."""
 from ncd.io.netcdf import provenance, write_dataset
-from ncd.pipeline.workflow import start
-from ncd.studies.bench import environment, sweeps_table
+from ncd.pipeline.jobs import start
+from ncd.studies.bench.solver import environment, sweeps_table
 
-log = start(snakemake)  # noqa: F821 (snakemake is injected)
-cfg = snakemake.params.config  # noqa: F821
+log = start(snakemake)  # snakemake is injected
+cfg = snakemake.params.config
 ds = sweeps_table(cfg, log)
 ds.attrs.update(provenance(cfg, **environment()))
-write_dataset(ds, snakemake.output[0])  # noqa: F821
+write_dataset(ds, snakemake.output[0])

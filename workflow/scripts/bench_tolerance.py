@@ -7,22 +7,22 @@ import xarray as xr
 
 from ncd.dynamics.stepper import initial_guess, prepare_step
 from ncd.io.netcdf import provenance, write_dataset
-from ncd.pipeline.workflow import start
-from ncd.scenes import pile, slope
-from ncd.studies.bench import environment, tolerance_table
-from ncd.studies.finish_bench import FIELDS, METHODS, time_to_tolerance
+from ncd.pipeline.jobs import start
+from ncd.shared import pile, slope
+from ncd.studies.bench.finish import FIELDS, METHODS, time_to_tolerance
+from ncd.studies.bench.solver import environment, tolerance_table
 
-log = start(snakemake)  # noqa: F821 (snakemake is injected)
-cfg = snakemake.params.config  # noqa: F821
+log = start(snakemake)  # snakemake is injected
+cfg = snakemake.params.config
 ds = tolerance_table(cfg, log)
 ds.attrs.update(provenance(cfg, **environment()))
-write_dataset(ds, snakemake.output.packings)  # noqa: F821
+write_dataset(ds, snakemake.output.packings)
 
-pcfg, scfg = snakemake.params.pile, snakemake.params.slope  # noqa: F821
-construction = xr.load_dataset(snakemake.input.construction)  # noqa: F821
+pcfg, scfg = snakemake.params.pile, snakemake.params.slope
+construction = xr.load_dataset(snakemake.input.construction)
 scene = pile.final_scene(pcfg, construction)
 problems = {"pile": (scene, pile.equilibrium_problem(pcfg, scene, construction), None)}
-traj = xr.load_dataset(snakemake.input.trajectory)  # noqa: F821
+traj = xr.load_dataset(snakemake.input.trajectory)
 scene = slope.scene_at_step(traj, scfg)
 step = prepare_step(scene, float(traj.attrs["h"]))
 problems["fig2_step"] = (scene, step, None)
@@ -43,4 +43,4 @@ ds["problem"].attrs.update(units="1", long_name="step problem: the pile's final 
                                                 "from the zero guess and from the previous step's impulses (warm)")
 ds["order"].attrs.update(units="1", long_name="review order: 0 identity, k > 0 permutation of rng((k, root_seed))")
 ds.attrs.update(provenance(cfg, **environment()))
-write_dataset(ds, snakemake.output.problems)  # noqa: F821
+write_dataset(ds, snakemake.output.problems)

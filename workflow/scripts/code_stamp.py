@@ -6,10 +6,10 @@ import hashlib
 import os
 from pathlib import Path
 
-files = list(snakemake.input)  # noqa: F821 (snakemake is injected)
+files = list(snakemake.input)  # snakemake is injected
 base = os.path.dirname(os.path.commonpath(files))          # every set holds ncd/__init__.py and ncd/core
-algorithm = snakemake.params.algorithm  # noqa: F821
+algorithm = snakemake.params.algorithm
 lines = [f"{hashlib.new(algorithm, Path(f).read_bytes()).hexdigest()}  {Path(os.path.relpath(f, base)).as_posix()}"
          for f in files]
-Path(snakemake.output[0]).write_text("\n".join(lines) + "\n")  # noqa: F821
-Path(snakemake.log[0]).write_text(f"{len(lines)} sources hashed ({algorithm}) into {snakemake.output[0]}\n")  # noqa: F821
+Path(snakemake.output[0]).write_text("\n".join(lines) + "\n")
+Path(snakemake.log[0]).write_text(f"{len(lines)} sources hashed ({algorithm}) into {snakemake.output[0]}\n")

@@ -2,13 +2,13 @@
 import xarray as xr
 
 from ncd.io.netcdf import write_dataset
-from ncd.pipeline.workflow import start
-from ncd.scenes import slope_analysis
+from ncd.pipeline.jobs import start
+from ncd.shared import slope_analysis
 
-log = start(snakemake)  # noqa: F821 (snakemake is injected)
-traj = xr.load_dataset(snakemake.input.trajectory)  # noqa: F821
-ens = xr.load_dataset(snakemake.input.ensemble)  # noqa: F821
-ds = slope_analysis.measures_dataset(traj, ens, snakemake.params.config)  # noqa: F821
-write_dataset(ds, snakemake.output[0])  # noqa: F821
+log = start(snakemake)  # snakemake is injected
+traj = xr.load_dataset(snakemake.input.trajectory)
+ens = xr.load_dataset(snakemake.input.ensemble)
+ds = slope_analysis.measures_dataset(traj, ens, snakemake.params.config)
+write_dataset(ds, snakemake.output[0])
 log.info("grain %d, verdict: %s; %s", int(ds.attrs["grain"]), ds.attrs["verdict"],
          ", ".join(f"{k} {ds.attrs[k]:.3g}" for k in ds.attrs if k.startswith("verdict_")))

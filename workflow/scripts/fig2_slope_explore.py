@@ -3,16 +3,17 @@ import xarray as xr
 
 from ncd.dynamics.explore import shard_members
 from ncd.io.netcdf import write_dataset
-from ncd.pipeline.workflow import Progress, start
-from ncd.scenes import slope
+from ncd.io.progress import Progress
+from ncd.pipeline.jobs import start
+from ncd.shared import slope
 
-log = start(snakemake)  # noqa: F821 (snakemake is injected)
-w = snakemake.wildcards  # noqa: F821
-cfg = snakemake.params.config  # noqa: F821
+log = start(snakemake)  # snakemake is injected
+w = snakemake.wildcards
+cfg = snakemake.params.config
 members = shard_members(cfg["explore"]["runs"], int(w.shard), int(w.n))
-traj = xr.load_dataset(snakemake.input.trajectory)  # noqa: F821
+traj = xr.load_dataset(snakemake.input.trajectory)
 ds = slope.run_ensemble(traj, cfg, members, Progress(log, 0, f"shard {w.shard}/{w.n}"))
-write_dataset(ds, snakemake.output[0])  # noqa: F821
+write_dataset(ds, snakemake.output[0])
 last = ds.isel(tol=-1)
 log.info("%d members x %d inits, %d converged at tol %.0e, sweeps median %d max %d, %.1f s of NLGS",
          ds.sizes["run"], ds.sizes["init"], int(last.converged.sum()), float(ds.tol[-1]),

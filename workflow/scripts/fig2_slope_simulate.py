@@ -1,12 +1,13 @@
 """Figure 2: deposit, release and flow of the discs down the slope (trajectory.nc)."""
 from ncd.io.netcdf import write_dataset
-from ncd.pipeline.workflow import Progress, start
-from ncd.scenes import slope
+from ncd.io.progress import Progress
+from ncd.pipeline.jobs import start
+from ncd.shared import slope
 
-log = start(snakemake)  # noqa: F821 (snakemake is injected)
-cfg = snakemake.params.config  # noqa: F821
+log = start(snakemake)  # snakemake is injected
+cfg = snakemake.params.config
 ds = slope.trajectory_dataset(cfg, Progress(log, 0, "deposit and flow"))
-write_dataset(ds, snakemake.output[0])  # noqa: F821
+write_dataset(ds, snakemake.output[0])
 k = int(ds.attrs["investigated_step"]) - 1
 log.info("deposit: %d steps; flow: %d steps, %d not converged; investigated step %d at t = %.4f s: "
          "%d contacts, mean vx %.4g m/s", ds.sizes["deposit_step"], ds.sizes["step"], int((ds.converged == 0).sum()),

@@ -1,23 +1,23 @@
 """Figure 4 over construction histories: ground stress, dip and arching over the piles (analysis_n<n>.nc)."""
 import xarray as xr
 
-from ncd.figures import history_analysis
+from ncd.figures.fig4_history import analysis as history_analysis
 from ncd.io.netcdf import provenance, write_dataset
-from ncd.pipeline.workflow import start
+from ncd.pipeline.jobs import start
 
-log = start(snakemake)  # noqa: F821 (snakemake is injected)
-cfg = snakemake.params.config  # noqa: F821
+log = start(snakemake)  # snakemake is injected
+cfg = snakemake.params.config
 files = {}
-for path in snakemake.input.piles:  # noqa: F821
+for path in snakemake.input.piles:
     ds = xr.load_dataset(path)
     files.setdefault(ds.attrs["history"], []).append(ds)
 exact = {}
-for path in snakemake.input.exact:  # noqa: F821
+for path in snakemake.input.exact:
     e = xr.load_dataset(path)
     exact[(e.attrs["history"], int(e.attrs["member"]))] = e
 out = history_analysis.ensemble_dataset(cfg, files, exact)
 out.attrs.update(provenance(cfg))
-write_dataset(out, snakemake.output[0])  # noqa: F821
+write_dataset(out, snakemake.output[0])
 for h in out.history.values:
     k = out.kernel.values[0]
     s = out.sel(history=h, kernel=k)

@@ -4,24 +4,24 @@ import os
 import xarray as xr
 
 from ncd.core.errors import InputError
-from ncd.figures import history
+from ncd.figures.fig4_history import construct as history
 from ncd.io.netcdf import write_dataset
-from ncd.pipeline.workflow import start
+from ncd.pipeline.jobs import start
 
-log = start(snakemake)  # noqa: F821 (snakemake is injected)
-cfg = snakemake.params.config  # noqa: F821
-w = snakemake.wildcards  # noqa: F821
+log = start(snakemake)  # snakemake is injected
+cfg = snakemake.params.config
+w = snakemake.wildcards
 if int(w.n) != cfg["grains"]["n"]:
     raise InputError(f"file name n{w.n} differs from fig4_history.grains.n = {cfg['grains']['n']}")
 half = None
 if w.history == "rain":   # the finite base of the rain: the member's point-source pile's base half-width
-    with xr.open_dataset(snakemake.input.point) as p:  # noqa: F821
+    with xr.open_dataset(snakemake.input.point) as p:
         half = float(p.attrs["base_half_width"])
-checkpoint = snakemake.params.checkpoint  # noqa: F821
+checkpoint = snakemake.params.checkpoint
 info = {}
 scene, rec, ground, eq, frames = history.construct(cfg, w.history, int(w.member), half, log, checkpoint, info)
 ds = history.pile_dataset(cfg, w.history, int(w.member), scene, rec, ground, eq, frames, half, info)
-write_dataset(ds, snakemake.output[0])  # noqa: F821
+write_dataset(ds, snakemake.output[0])
 if os.path.exists(checkpoint):
     os.remove(checkpoint)
 d = ds.attrs["mean_diameter"]

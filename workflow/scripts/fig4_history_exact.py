@@ -1,16 +1,16 @@
 """Figure 4 over construction histories: exact angle ranges over A ∩ C at the arching cuts of one pile (HiGHS LPs)."""
 import xarray as xr
 
-from ncd.figures import history_exact
+from ncd.figures.fig4_history import exact as history_exact
 from ncd.io.netcdf import provenance, write_dataset
-from ncd.pipeline.workflow import start
+from ncd.pipeline.jobs import start
 
-log = start(snakemake)  # noqa: F821 (snakemake is injected)
-cfg = snakemake.params.config  # noqa: F821
-pile = xr.load_dataset(snakemake.input.pile)  # noqa: F821
+log = start(snakemake)  # snakemake is injected
+cfg = snakemake.params.config
+pile = xr.load_dataset(snakemake.input.pile)
 out = history_exact.exact_ranges(cfg, pile, log)
 out.attrs.update(provenance(cfg))
-write_dataset(out, snakemake.output[0])  # noqa: F821
+write_dataset(out, snakemake.output[0])
 log.info("exact deviation ranges (deg): min %s, max %s; history angle outside the exact range by at most %.2g degree",
          out.exact_deviation_min.values.round(1).tolist(), out.exact_deviation_max.values.round(1).tolist(),
          float(out.history_outside.max()))

@@ -1,15 +1,15 @@
 """Figure 4 over construction histories, size study: the analyses of every pile size side by side (size.nc)."""
 import xarray as xr
 
-from ncd.figures import history_size
+from ncd.figures.fig4_history import size as history_size
 from ncd.io.netcdf import provenance, write_dataset
-from ncd.pipeline.workflow import start
+from ncd.pipeline.jobs import start
 
-log = start(snakemake)  # noqa: F821 (snakemake is injected)
-analyses = [xr.load_dataset(p) for p in snakemake.input.analyses]  # noqa: F821
-out = history_size.size_dataset(analyses, seed=snakemake.params.seed)  # noqa: F821
-out.attrs.update(provenance({"seed": snakemake.params.seed, "analyses": len(analyses)}))  # noqa: F821
-write_dataset(out, snakemake.output[0])  # noqa: F821
+log = start(snakemake)  # snakemake is injected
+analyses = [xr.load_dataset(p) for p in snakemake.input.analyses]
+out = history_size.size_dataset(analyses, seed=snakemake.params.seed)
+out.attrs.update(provenance({"seed": snakemake.params.seed, "analyses": len(analyses)}))
+write_dataset(out, snakemake.output[0])
 for h in out.history.values:
     s = out.sel(history=h)
     log.info("%s: grains %s, dip %s, arching %s deg (p %s)", h, out.grains.values.tolist(),

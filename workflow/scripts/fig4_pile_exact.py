@@ -1,14 +1,14 @@
 """Figure 4: the exact set A ∩ C of the final pile by LP -- cut polygons, angle ranges, ground pressure (exact.nc)."""
 import xarray as xr
 
-from ncd.figures import pile_exact
+from ncd.figures.fig4_pile import exact as pile_exact
 from ncd.io.netcdf import write_dataset
-from ncd.pipeline.workflow import start
+from ncd.pipeline.jobs import start
 
-log = start(snakemake)  # noqa: F821 (snakemake is injected)
-ds = pile_exact.exact_dataset(snakemake.params.config, xr.load_dataset(snakemake.input.construction),  # noqa: F821
-                              xr.load_dataset(snakemake.input.cuts), log)  # noqa: F821
-write_dataset(ds, snakemake.output[0])  # noqa: F821
+log = start(snakemake)  # snakemake is injected
+ds = pile_exact.exact_dataset(snakemake.params.config, xr.load_dataset(snakemake.input.construction),
+                              xr.load_dataset(snakemake.input.cuts), log)
+write_dataset(ds, snakemake.output[0])
 a = ds.attrs
 m = list(ds.choice.values).index(a["dip_main_choice"])
 log.info("default cut: %d vertices, %d LPs, %.1f s; cuts where every admissible state arches: %d of %d; "

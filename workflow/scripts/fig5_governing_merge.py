@@ -1,10 +1,10 @@
 """Figure 5: merge the build and analysis shards into packings.nc."""
-from ncd.figures import governing
+from ncd.figures.fig5_governing import measure as governing
 from ncd.io.netcdf import write_dataset
-from ncd.pipeline.workflow import start
+from ncd.pipeline.jobs import start
 
-log = start(snakemake)  # noqa: F821 (snakemake is injected)
-inp = snakemake.input  # noqa: F821
+log = start(snakemake)  # snakemake is injected
+inp = snakemake.input
 ds = governing.merge(inp.packs, inp.analyses)
-write_dataset(ds, snakemake.output[0])  # noqa: F821
+write_dataset(ds, snakemake.output[0])
 log.info("merged %d analyses of %d builds", ds.sizes["packing"], ds.sizes["build"])

@@ -2,8 +2,8 @@
 from pathlib import Path
 
 from ncd.pages.report import write_page
-from ncd.pipeline.workflow import start
+from ncd.pipeline.jobs import start
 
-log = start(snakemake)  # noqa: F821 (snakemake is injected)
-out = Path(snakemake.output[0])  # noqa: F821
-log.info("wrote %s", write_page(out.parent, snakemake.params.figures, snakemake.params.config, out))  # noqa: F821
+log = start(snakemake)  # snakemake is injected
+out = Path(snakemake.output[0])
+log.info("wrote %s", write_page(out.parent, snakemake.params.figures, snakemake.params.config, out))

@@ -1,0 +1,102 @@
+"""Figure 1's rows on the index: §1 (two evolutions, the wedging threshold, the segment of I,
+forces as state) and the §2 bound on the solutions reached by review orders.
+"""
+import math
+
+import numpy as np
+
+from ncd.shared.verdict import DIFFERS, REPRODUCED, judged, open_data, pct
+
+F1_ENS, F1_SWEEP, F1_EVOL = "fig1_wedged/ensemble.nc", "fig1_wedged/sweep.nc", "fig1_wedged/evolutions.nc"
+
+def fig1_two_evolutions(results):
+    ens = open_data(results, F1_ENS)
+    outcome, zero = ens.outcome.values, ens.zero_guess.values.astype(bool)
+    falls_zero = np.mean(outcome[zero] == 0)
+    wedged_rand, falls_rand = np.mean(outcome[~zero] == 1), np.mean(outcome[~zero] == 0)
+    both = (outcome == 0).any() and (outcome == 1).any()
+    return judged(f"zero guess: {pct(falls_zero)} of {zero.sum()} runs fall; random guesses: "
+              f"{pct(wedged_rand)} of {(~zero).sum()} wedge, {pct(falls_rand)} fall",
+              REPRODUCED if both else DIFFERS, "both outcomes occur among converged runs of the same step",
+              "s1-two-evolutions", F1_ENS)
+
+
+def fig1_threshold(results):
+    swp = open_data(results, F1_SWEEP)
+    gamma, frac = swp.gamma.values, swp.wedged_fraction.values
+    beta = float(swp.attrs["threshold_gamma_deg"])
+    below, above = frac[gamma < beta], frac[gamma > beta]
+    ok = np.all(below == 0) and np.all(above > 0)
+    first = gamma[frac > 0].min() if (frac > 0).any() else np.nan
+    return judged(f"wedged fraction 0 at all {len(below)} angles γ < β = {beta:.1f}°, > 0 at "
+              f"{np.sum(above > 0)} of {len(above)} angles γ > β (first at {first:.1f}°)",
+              REPRODUCED if ok else DIFFERS, "no wedging for γ < β, wedging for every γ > β",
+              "s1-wedging-threshold", F1_SWEEP)
+
+
+def _wedged_on_segment(ens):
+    wedged = ens.outcome.values == 1
+    R, lo, hi = float(ens.attrs["radius"]), float(ens.attrs["I_y_bottom"]), float(ens.attrs["I_y_top"])
+    ix, iy = ens.I_x.values[wedged], ens.I_y.values[wedged]
+    on = (np.abs(ix) <= 1e-6 * R) & (iy >= lo - 1e-6 * R) & (iy <= hi + 1e-6 * R)
+    return wedged, on, ix, iy, R, lo, hi
+
+
+def fig1_segment(results):
+    ens = open_data(results, F1_ENS)
+    wedged, on, ix, iy, R, lo, hi = _wedged_on_segment(ens)
+    if not wedged.any():
+        return judged("no wedged run", DIFFERS, "every wedged I on the closed-form vertical segment", "s1-segment", F1_ENS)
+    return judged(f"{on.sum()} of {wedged.sum()} wedged I on the segment [{lo / R:.3f} R, {hi / R:.3f} R] "
+              f"(largest |x_I| {np.abs(ix).max() / R:.1e} R)", REPRODUCED if on.all() else DIFFERS,
+              "every wedged I within 10⁻⁶ R of the closed-form segment", "s1-segment", F1_ENS)
+
+
+def fig1_undetermined(results):
+    ens = open_data(results, F1_ENS)
+    wedged, on, ix, iy, R, lo, hi = _wedged_on_segment(ens)
+    if wedged.sum() < 2:
+        return judged(f"{wedged.sum()} wedged run(s)", DIFFERS, "wedged runs spread along the segment",
+                  "s1-forces-undetermined", F1_ENS)
+    cover = (iy.max() - iy.min()) / (hi - lo)
+    return judged(f"the {wedged.sum()} wedged runs put I at {len(np.unique(np.round(iy / R, 6)))} distinct heights, "
+              f"covering {pct(cover)} of the segment", REPRODUCED if cover >= 0.5 else DIFFERS,
+              "wedged runs of one step reach distinct force states over at least half the segment",
+              "s1-forces-undetermined", F1_ENS)
+
+
+def fig1_forces_as_state(results):
+    ev = open_data(results, F1_EVOL)
+    names = [s.split(":")[0].strip() for s in str(ev.attrs["evolutions"]).split(";")]
+    drop = ev.y.values[:, 0] - ev.y.values[:, -1]
+    R = float(ev.attrs["radius"])
+    zero, warm = names.index("zero_guess"), names.index("wedged_warm")
+    ok = drop[zero] > R and abs(drop[warm]) < 1e-6 * R
+    return judged(f"same position and velocity at t0: from the zero guess B falls {drop[zero] / R:.1f} R in "
+              f"{float(ev.attrs['duration']):g} s; with the wedged contact forces carried from step to step it "
+              f"moves {abs(drop[warm]) / R:.1e} R", REPRODUCED if ok else DIFFERS,
+              "the contact forces at t0 alone decide between falling and staying wedged",
+              "s1-forces-as-state", F1_EVOL)
+
+
+def fig1_review_orders(results):
+    ens = open_data(results, F1_ENS)
+    zero = ens.zero_guess.values.astype(bool) & ens.converged.values.astype(bool)
+    kappa = ens.sizes["contact"]
+    ends = np.unique(np.round(np.column_stack([ens.force_n.values[zero], ens.force_t.values[zero]]), 9), axis=0)
+    bound = math.factorial(kappa - 1)
+    return judged(f"κ = {kappa}: the {zero.sum()} converged zero-guess runs (both first-reviewed contacts) reach "
+              f"{len(ends)} distinct solution(s), against at most (κ − 1)! = {bound}",
+              REPRODUCED if len(ends) <= bound else DIFFERS, "distinct zero-guess limits ≤ (κ − 1)!",
+              "s2-review-orders", F1_ENS)
+
+
+# the judging functions of this package's rows, by claim id (ncd.pages.claims renders them)
+JUDGES = {
+    "s1-two-evolutions": (fig1_two_evolutions,),
+    "s1-wedging-threshold": (fig1_threshold,),
+    "s1-forces-undetermined": (fig1_undetermined,),
+    "s1-segment": (fig1_segment,),
+    "s1-forces-as-state": (fig1_forces_as_state,),
+    "s2-review-orders": (fig1_review_orders,),
+}
