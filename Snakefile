@@ -7,12 +7,12 @@ from pathlib import Path
 
 from snakemake.utils import min_version, validate
 
-min_version("8.0")
+min_version("9.10")
 
 configfile: str(Path(workflow.basedir) / "config.yaml")
 
 # One BLAS thread per job (inherited by every job's interpreter): with -j2 on 2 cores the
-# default OpenBLAS threads oversubscribe the cores (fig5's dense SVDs ran 6-18x slower), and
+# default OpenBLAS threads oversubscribe the cores (dense SVDs slow down several-fold), and
 # a fixed thread count keeps dense linear algebra's bits the same whatever -j.
 for _var in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
@@ -20,17 +20,17 @@ for _var in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 validate(config, str(Path(workflow.basedir) / "workflow/schemas/config.schema.yaml"))
 
 # Snakemake samples the process tree of every running job (psutil's memory_full_info reads
-# /proc/<pid>/smaps_rollup) every 0.5 s for a job's first 30 samples, then every 30 s: about
-# 0.35 s of this process's CPU per job.  The figures read only the benchmark files' wall time
-# `s`, measured apart from the samples, so a sample every 5 s serves (workflow/README.md).
+# /proc/<pid>/smaps_rollup) twice a second for a job's first samples, a cost of this process's
+# CPU per job.  The figures read only the benchmark files' wall time `s`, measured apart from
+# the samples, so a sample every 5 s serves (workflow/README.md).
 import snakemake.benchmark as _benchmark
 
 _benchmark.BENCHMARK_INTERVAL_SHORT = max(_benchmark.BENCHMARK_INTERVAL_SHORT, 5.0)
 
 # Snakemake's scheduler loop re-arms a one-second timer on each pass while jobs wait, and each
-# finished job starts one more chain of them: the loop ran about once a second per finished job
-# and its main process used 514 s of CPU on the default run, 28 s with one pending timer at a
-# time (ncd.pipeline.scheduler.coalesce_reevaluations; workflow/README.md).
+# finished job starts one more chain of them: the loop runs about once a second per finished job,
+# a cost that grows with the run; one pending timer at a time wakes it as surely
+# (ncd.pipeline.scheduler.coalesce_reevaluations; workflow/README.md).
 from ncd.pipeline.scheduler import coalesce_reevaluations
 
 coalesce_reevaluations()

@@ -12,7 +12,7 @@ Public API::
 The package is layered, each subpackage importing only from those below it
 (checked by ``lint-imports`` and ``tests/test_layers.py``): ``core`` (scene,
 contacts, validation) < ``io`` < ``solver`` < ``exact`` | ``dynamics`` <
-``pipeline`` < ``scenes`` < ``figures`` < ``studies`` < ``pages``.
+``shared`` < ``figures`` < ``studies`` < ``pages`` < ``pipeline``.
 
 The public names load on first use (PEP 562): a workflow job that imports one layer that
 needs no kernel, say ``ncd.pages.render`` or a shard merge, does not pay for importing numba

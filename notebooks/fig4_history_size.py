@@ -38,7 +38,7 @@
 import xarray as xr
 from IPython.display import Markdown, display
 
-from ncd.figures.fig4_history import size as hs
+from ncd.figures.fig4_history import size_plots as hs
 from ncd.pages.notebook import save, write_finding
 
 try:

@@ -10,12 +10,12 @@ import xarray as xr
 import yaml
 
 import ncd
-from ncd.core.contacts import h_matrix
+from ncd.core.contacts import external_load, h_matrix
 from ncd.dynamics.explore import member_rng
 from ncd.exact.polygon import boundary_distance, convex_hull, outside_distance, polygon_area
 from ncd.exact.polytope import ForcePolytope, PolytopeError
 from ncd.figures.fig3_equilibrium import measure as fe
-from ncd.figures.fig3_equilibrium.packing import external_force, rest_problem
+from ncd.figures.fig3_equilibrium.packing import rest_problem
 
 
 # ---------------------------------------------------------------- unit tests
@@ -66,7 +66,7 @@ def _wedge(beta_deg, mu):
     scene = ncd.make_scene([[0.0, 0.0]], R, 1.0, obstacle_pos=[-d, [d[0], -d[1]]], obstacle_radius=Ro, mu=mu)
     problem = rest_problem(scene, 1e-3)
     assert problem.contacts.n == 2
-    F = external_force(scene)
+    F = external_load(scene)
     return ForcePolytope(h_matrix(scene, problem.contacts), F, problem.contacts.mu), -F[1], b
 
 

@@ -387,9 +387,9 @@ def test_the_largest_piles_exact_ranges_by_interior_point_hold_the_history_angle
 def test_size_study_states_each_sizes_exact_ranges(size, results):
     """size.nc carries, per size and history, the exact ranges of the piles that have them,
     recomputed here from each analysis; the page's sentence states them."""
-    from ncd.figures.fig4_history import size as hsz
+    from ncd.figures.fig4_history import size_plots
 
-    text = hsz.exact_text(size)
+    text = size_plots.exact_text(size)
     for z, n in enumerate(_sizes(results)):
         an = xr.load_dataset(results / "fig4_history" / f"analysis_n{n}.nc")
         cfg = yaml.safe_load(an.attrs["config_yaml"])
@@ -415,13 +415,14 @@ def test_size_study_states_each_sizes_exact_ranges(size, results):
 
 def test_size_study_without_exact_ranges_says_so(analysis):
     from ncd.figures.fig4_history import size as hsz
+    from ncd.figures.fig4_history import size_plots
 
     bare = analysis.drop_vars([v for v in analysis.data_vars if v.startswith("exact_")])
     sz = hsz.size_dataset([analysis, bare.assign(n_grains=bare.n_grains * 10)])
     assert np.all(sz.exact_piles.values[1] == 0) and np.isnan(sz.exact_width_median.values[1]).all()
     assert np.all(sz.exact_piles.values[0] > 0)
     n = int(sz.grains.values[1])
-    assert f"{n} grains, point: no exact ranges computed." in hsz.exact_text(sz)
+    assert f"{n} grains, point: no exact ranges computed." in size_plots.exact_text(sz)
 
 
 def test_size_comparison_sees_a_shift_and_not_a_null(analysis):

@@ -11,7 +11,7 @@ import xarray as xr
 import yaml
 
 import ncd
-from ncd.core.contacts import h_matrix
+from ncd.core.contacts import external_load, h_matrix
 from ncd.exact.polytope import ForcePolytope
 from ncd.figures.fig5_governing import claims as gc
 from ncd.figures.fig5_governing import exact as ge
@@ -74,7 +74,7 @@ def test_mobile_plate_is_balanced_and_moves_along_its_normal(frictionless_cell):
     assert np.abs(forces[top, 1]).max() == 0.0
     assert cell.scene.vel[cell.n, 0] == 0.0 and cell.scene.pos[cell.n, 0] == pytest.approx(0.5 * cell.scene.period)
     H = h_matrix(cell.scene, contacts)
-    r = np.abs(H @ forces.ravel() + plates.external_force(cell)).max()
+    r = np.abs(H @ forces.ravel() + external_load(cell.scene, plates.plate_load(cell))).max()
     assert r <= 1e-9 * cell.force
     assert fg.plates_bounded(cell, contacts)
     assert info["max_penetration"] < 0.2

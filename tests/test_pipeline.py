@@ -1,5 +1,4 @@
 """The Snakemake DAG: validation before any job, incremental reruns, shard invariance."""
-import ast
 import json
 import os
 import re
@@ -156,48 +155,23 @@ def test_an_ensemble_does_not_depend_on_shards_threads_or_jobs(dag_repo, tmp_pat
     xr.testing.assert_identical(ref.drop_vars(timing).drop_attrs(), new.drop_vars(timing).drop_attrs())
 
 
-def smk_table(name):
-    """A literal table of workflow/rules/common.smk (STUDY_MODULES, LOWER_LAYERS...)."""
-    text = (ROOT / "workflow" / "rules" / "common.smk").read_text()
-    block = re.search(rf"^{name} = (.*\n(?:[ \t].*\n)*(?:[}})\]].*)?)", text, re.M).group(1)
-    return ast.literal_eval(block)
-
-
-def test_every_study_module_is_a_source_of_the_studies_that_import_it():
-    """STUDY_MODULES (common.smk) lists, per study, its modules of ncd/studies; a study
-    module imported by a listed one must be listed too, and every module of ncd/studies
-    belongs to some study.  (Figure modules: ncd.figures.FIGURE_MODULES, tests/test_layers.py.)"""
-    modules = smk_table("STUDY_MODULES")
-    listed = set()
-    for study, files in modules.items():
-        listed.update(files)
-        for f in files:
-            if not f.endswith(".py"):
-                continue
-            for node in ast.walk(ast.parse((ROOT / "ncd" / "studies" / f).read_text())):
-                if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("ncd.studies"):
-                    deps = ([f"{node.module[12:]}.py"] if node.module != "ncd.studies"
-                            else [f"{a.name}.py" for a in node.names])
-                    for d in deps:
-                        assert d in files, f"{study}: {f} imports {d}, not in STUDY_MODULES[{study!r}]"
-    own = {p.name for p in (ROOT / "ncd" / "studies").iterdir() if p.suffix in (".py", ".c") and p.stem != "__init__"}
-    assert own == listed, own ^ listed
-
-
-def test_the_computing_rules_depend_on_the_lower_layers_only():
-    """Every subpackage below the figures is a source of every computing rule, and none
-    above (pages, studies, figures) is in that common list."""
-    layers = smk_table("LOWER_LAYERS")
-    import tomllib
-    order = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["importlinter"]["contracts"][0]["layers"]
-    below = [n.strip() for layer in order[order.index("scenes"):] for n in layer.split("|")]
-    assert sorted(layers) == sorted(below)
-
-
 ALL_FIGURES = FIGURES + [f for f in ("stability", "error_vs_runtime") if f in CONFIG]
-OWN_MODULE = {"fig1_wedged": "figures/wedged.py", "fig2_slope": "figures/census.py",
-              "fig3_equilibrium": "figures/equilibrium.py", "fig4_pile": "figures/pile.py",
-              "stability": "studies/stability.py", "error_vs_runtime": "studies/work_precision.py"}
+# the computation of each figure's package: an edit of it reruns that figure's jobs
+OWN_MODULE = {"fig1_wedged": "figures/fig1_wedged/measure.py", "fig2_slope": "figures/fig2_slope/census.py",
+              "fig3_equilibrium": "figures/fig3_equilibrium/measure.py", "fig4_pile": "figures/fig4_pile/measure.py",
+              "fig4_history": "figures/fig4_history/analysis.py", "fig4_bank": "figures/fig4_bank/measure.py",
+              "fig5_governing": "figures/fig5_governing/measure.py",
+              "stability": "studies/stability/measure.py", "error_vs_runtime": "studies/error_vs_runtime/measure.py"}
+# what only a figure's page reads: its plots and sentences (page.py or plots.py) and its claims
+PAGE_ONLY = {"fig1_wedged": ("page.py", "claims.py"), "fig2_slope": ("page.py", "claims.py"),
+             "fig3_equilibrium": ("plots.py", "claims.py"), "fig4_pile": ("plots.py", "claims.py"),
+             "fig4_history": ("plots.py", "claims.py"), "fig4_bank": ("plots.py", "claims.py"),
+             "fig5_governing": ("plots.py", "summary.py"),
+             "stability": ("page.py", "claims.py"), "error_vs_runtime": ("page.py", "claims.py")}
+
+
+def package_of(figure):
+    return f"{'studies' if figure in ('stability', 'error_vs_runtime') else 'figures'}/{figure}"
 
 
 @pytest.mark.parametrize("figure", ALL_FIGURES)
@@ -245,6 +219,17 @@ def test_editing_a_figure_module_reruns_that_figure_only(dag_repo, figure):
         assert {f"{f}_notebook" for f in ALL_FIGURES} <= set(core), core
 
 
+@pytest.mark.parametrize("figure", ALL_FIGURES)
+def test_editing_a_figures_plots_page_or_claims_reruns_only_its_notebook_and_pages(dag_repo, figure):
+    """A figure's plots, page sentences and claims are read by its notebook (and its claims
+    by the index): an edit of one plans that notebook, the page render and the index,
+    no computation of any figure."""
+    for name in PAGE_ONLY[figure]:
+        jobs = set(plan_after_editing(dag_repo, f"{package_of(figure)}/{name}")) - {"all", "code_stamp"}
+        assert f"{figure}_notebook" in jobs, (name, jobs)
+        assert jobs <= {f"{figure}_notebook", "render_html", "index"}, (name, jobs)
+
+
 def test_editing_the_exact_layer_reruns_the_history_exact_ranges_not_the_piles(dag_repo):
     """The pile construction imports nothing of ncd/exact: an edit there plans the exact
     ranges of fig4_history (and what reads them), never a construction."""
@@ -253,15 +238,18 @@ def test_editing_the_exact_layer_reruns_the_history_exact_ranges_not_the_piles(d
 
 
 def test_a_code_stamp_holds_the_hash_of_each_source_of_its_set(dag_repo):
-    """A computing rule lists one stamp for its sources (results/code/<name>.sha256): the
-    SHA-256 of every file of the set, by path in the checkout; the lower layers and the
-    figure's own modules are in it, its page modules and ncd/pages are not."""
+    """A computing rule lists one stamp for its sources (results/code/<script>.sha256): the
+    SHA-256 of every file its script imports, by path in the checkout; the lower layers and
+    the figure's computation are in it, its page, plots, claims, ncd/pages and the other
+    figures are not."""
     import hashlib
-    lines = (dag_repo / "results" / "code" / "fig1_wedged.sha256").read_text().splitlines()
+    lines = (dag_repo / "results" / "code" / "fig1_explore.sha256").read_text().splitlines()
     stamp = dict(reversed(line.split("  ", 1)) for line in lines)
     assert len(stamp) == len(lines) > 20
-    assert {"ncd/solver/nlgs.py", "ncd/core/contacts.py", "ncd/figures/fig1_wedged/measure.py"} <= set(stamp)
-    assert not [p for p in stamp if p.startswith("ncd/pages/") or p.endswith("_page.py")]
+    assert {"ncd/solver/nlgs.py", "ncd/core/contacts.py", "ncd/figures/fig1_wedged/measure.py",
+            "workflow/scripts/fig1_explore.py", "ncd/__init__.py", "ncd/figures/__init__.py"} <= set(stamp)
+    assert not [p for p in stamp if p.startswith(("ncd/pages/", "ncd/figures/fig2", "ncd/studies/"))
+                or p.endswith(("page.py", "plots.py", "claims.py"))]
     for path, digest in stamp.items():
         assert hashlib.sha256((dag_repo / path).read_bytes()).hexdigest() == digest, path
 

@@ -217,8 +217,11 @@ def test_quick_start_has_a_virtual_environment_and_two_commands():
 
 def test_layout_names_the_layers_and_the_import_check():
     text = section("Layout")
-    for pkg in ("core", "io", "solver", "exact", "dynamics", "pipeline", "scenes", "figures", "studies", "pages"):
+    import tomllib
+    layers = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["importlinter"]["contracts"][0]["layers"]
+    for pkg in (n.strip() for layer in layers for n in layer.split("|")):
         assert f"`ncd/{pkg}`" in text, pkg
+    assert "`ncd/figures/<config key>/`" in text
     for path in ("workflow/", "notebooks/", "tests/", "docs/"):
         assert path in text, path
     assert "lint-imports" in text and "tests/test_layers.py" in text

@@ -84,13 +84,13 @@ def test_md_coulomb_slider_on_incline():
 
 def test_md_forces_balance_weight_at_rest():
     """A damped disc settles on the floor: the floor's force equals its weight."""
-    from ncd.dynamics.md import external_force
+    from ncd.dynamics.md import wall_reaction
     s = ncd.make_scene([[0.0, R]], R, 1.0, walls=[((0.0, 0.0), (0.0, 1.0))], mu=0.5)
     k_n = 1.0e3
     md = MD(s, MDParams(k_n=k_n))
     md.run(0.05 * critical_step(s, k_n), 20000)
     c, f = md.contact_forces()
-    assert external_force(s, c, f)[1] == pytest.approx(s.mass[0] * 9.81, rel=1e-6)
+    assert wall_reaction(s, c, f)[1] == pytest.approx(s.mass[0] * 9.81, rel=1e-6)
 
 
 # ------------------------------------------------------------------ unconverged steps

@@ -242,6 +242,19 @@ def _match_sorted(keys, prev_keys, prev_impulse):
     return guess
 
 
+def external_load(scene: Scene, applied: np.ndarray | None = None) -> np.ndarray:
+    """The generalized external force ``F`` of the equilibrium equations ``H r + F = 0``
+    (Moreau 2005, section 4: they define the affine set A), flat (3 n_mobile,): the weight
+    ``m g`` of each mobile body plus the forces ``applied`` to them, shape (n_mobile, 2)
+    (the load on Unger et al.'s top plate); no external torque."""
+    nm = scene.n_mobile
+    F = np.zeros((nm, 3))
+    F[:, :2] = scene.mass[:nm, None] * scene.gravity[None]
+    if applied is not None:
+        F[:, :2] += np.asarray(applied, dtype=float).reshape(nm, 2)
+    return F.ravel()
+
+
 def h_matrix(scene: Scene, contacts: Contacts) -> sp.csr_matrix:
     """The sparse matrix ``H`` (3 n_mobile, 2 n): generalized force of the impulses.
 

@@ -292,7 +292,7 @@ def potential_energy(scene):
     return float(-np.sum(scene.mass[:nm] * (scene.pos[:nm] @ scene.gravity)))
 
 
-def external_force(scene, contacts, forces):
+def wall_reaction(scene, contacts, forces):
     """Total force exerted by walls and fixed discs on the mobile discs, shape (2,)."""
     ext = (contacts.body_b < 0) | (contacts.body_b >= scene.n_mobile)
     f = forces[ext]

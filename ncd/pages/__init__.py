@@ -1,3 +1,3 @@
-"""Layer 9, pages: what turns data into pages: notebook helpers, HTML rendering, the
+"""Layer 8, pages: what turns data into pages: notebook helpers, HTML rendering, the
 reproduction page ``results/index.html`` (:mod:`ncd.pages.report`) and the config reference.
 """

@@ -1,4 +1,4 @@
-"""Layer 8, studies: the solver itself rather than a figure of the paper.
+"""Layer 7, studies: the solver itself rather than a figure of the paper.
 
 * :mod:`ncd.studies.cases` -- small scenes built here (not taken from the figures);
 * :mod:`ncd.studies.stability.measure` -- stability on stiff and extreme cases, Contact Dynamics

@@ -12,13 +12,13 @@ from dataclasses import replace
 import numpy as np
 import xarray as xr
 
-from ncd.core.contacts import h_matrix, match_warm
+from ncd.core.contacts import external_load, h_matrix, match_warm
 from ncd.core.scene import make_scene
 from ncd.dynamics.explore import explore, member_rng, shard_members
 from ncd.dynamics.stepper import equilibrium_test, step
 from ncd.exact.polygon import boundary_distance, hull_area
 from ncd.exact.polytope import ForcePolytope, PolytopeError
-from ncd.figures.fig3_equilibrium.packing import external_force, rest_problem
+from ncd.figures.fig3_equilibrium.packing import rest_problem
 from ncd.io.netcdf import provenance
 from ncd.solver.convergence import MAX_SPEED_ATTRS, REST, outcome_attrs
 from ncd.solver.settings import SolverSettings
@@ -193,24 +193,10 @@ def run_ensemble(state, cfg, mode, shard, n_shards, progress=None):
     return ds
 
 
-def convergence_history(state, cfg, mode, run, sweeps):
-    """Residual and wall time of run ``run`` of ``mode`` stopped after each number of
-    ``sweeps`` (the run is replayed from the start: same member, same guess and order)."""
-    scene, problem = scene_from_state(state)
-    base = _settings(cfg)
-    rows = []
-    for k in [1, *sweeps]:          # the first, discarded, replay compiles and warms the caches
-        s = SolverSettings(tol=1e-300, max_sweeps=int(k), criterion=base.criterion, check_every=base.check_every,
-                           keep_best=False)      # the iterate after k sweeps, not the best so far
-        out = explore(scene, problem, [run], cfg["root_seed"], settings=s, **_mode_args(state, cfg, mode))
-        rows.append((int(out["sweeps"][0]), float(out["residual"][0]), float(out["wall_time"][0])))
-    return np.array(rows[1:])
-
-
 def polytope_of(state):
     """:class:`ncd.exact.polytope.ForcePolytope` of the packing: ``H r + F = 0``, Coulomb sectors."""
     scene, problem = scene_from_state(state)
-    return ForcePolytope(h_matrix(scene, problem.contacts), external_force(scene), problem.contacts.mu)
+    return ForcePolytope(h_matrix(scene, problem.contacts), external_load(scene), problem.contacts.mu)
 
 
 def displayed_contacts(state, area, count):

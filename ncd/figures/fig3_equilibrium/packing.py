@@ -2,8 +2,7 @@
 
 The rest problem is the one-step problem from ``u_i = 0`` with ``theta = 1`` (Moreau
 2005, section 2: a single step decides whether a position is an equilibrium); the
-external force is the right-hand side ``F`` of the equilibrium equations ``H r = F``
-that define the affine set A of section 4.
+external force of the equilibrium equations is :func:`ncd.core.contacts.external_load`.
 """
 
 import numpy as np
@@ -14,11 +13,3 @@ from ncd.dynamics.stepper import prepare_step
 def rest_problem(scene, h):
     """The core problem of one step from ``u_i = 0`` (the equilibrium test's problem)."""
     return prepare_step(scene, h, 1.0, vel=np.zeros_like(scene.vel), spin=np.zeros_like(scene.spin))
-
-
-def external_force(scene):
-    """Generalized external force per mobile disc ``(m g_x, m g_y, 0)``, flat (3 N,)."""
-    nm = scene.n_mobile
-    F = np.zeros((nm, 3))
-    F[:, :2] = scene.mass[:nm, None] * scene.gravity[None]
-    return F.ravel()

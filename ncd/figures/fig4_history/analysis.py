@@ -231,3 +231,39 @@ def ensemble_dataset(cfg, files, exact=None):
     out[X].attrs.update(units="1", long_name="x / base half-width")
     out[Q].attrs.update(units="1", long_name="cut position |x| / base half-width")
     return out
+
+
+def _nanmax(a):
+    """Largest finite value of ``a`` (NaN when none, without a warning)."""
+    a = np.asarray(a, float)
+    return float(np.nanmax(a)) if np.isfinite(a).any() else float("nan")
+
+
+EXACT_SUMMARY = {
+    "exact_piles": ("1", "piles of the history with exact angle ranges"),
+    "exact_cuts": ("1", "cuts of those piles with a finite exact angle range"),
+    "exact_width_median": ("degree", "median width of the finite exact angle ranges"),
+    "exact_width_max": ("degree", "largest width of a finite exact angle range"),
+    "exact_all_positive": ("1", "fraction of the cuts where every admissible resultant is steeper than the flank"),
+    "exact_all_negative": ("1", "fraction of the cuts where every admissible resultant is shallower than the flank"),
+    "exact_undefined": ("1", "fraction of the cuts whose admissible resultants surround zero (no angle range)"),
+    "exact_confirmed": ("1", f"fraction of the cuts whose range is certified to {CERTIFIED_TEXT} degree"),
+    "exact_outside_max": ("degree", "largest angle of a history resultant outside its exact range"),
+}
+
+
+def exact_summary(an, history):
+    """The exact angle ranges of one history's piles in ``an`` (an analysis dataset) in the
+    numbers of :data:`EXACT_SUMMARY`, or None when no pile of it has them.  Shared by the
+    history page and the size study, so both state the same numbers for the same piles."""
+    if "exact_computed" not in an or not int(an.exact_computed.sel(history=history).sum()):
+        return None
+    e = an.sel(history=history).where(an.exact_computed.sel(history=history) == 1, drop=True)
+    width = (e.exact_deviation_max - e.exact_deviation_min).values
+    return dict(exact_piles=int(e.sizes["pile"]), exact_cuts=int(np.isfinite(width).sum()),
+                exact_width_median=float(np.nanmedian(width)), exact_width_max=float(np.nanmax(width)),
+                exact_all_positive=float(np.mean(e.exact_deviation_min.values > 0)),
+                exact_all_negative=float(np.mean(e.exact_deviation_max.values < 0)),
+                exact_undefined=float(np.mean(np.isnan(width))),
+                exact_confirmed=float(np.mean(e.exact_confirmed.values, dtype=float)) if "exact_confirmed" in e else np.nan,
+                exact_outside_max=_nanmax(e.exact_history_outside.values))

@@ -9,7 +9,6 @@ holds as many grains as the point pile.  Construction: :func:`ncd.shared.constru
 (checkpoints, frames); one netCDF file per pile.
 """
 import numpy as np
-import xarray as xr
 
 from ncd.shared.construction import add_frames, build
 from ncd.shared.pile import add_to_pile, construction_dataset, free_surface, make_ground, pile_scene
@@ -128,13 +127,3 @@ def ground_forces(ds):
     nx, ny = ds["normal_x"].values[g], ds["normal_y"].values[g]
     fn, ft = ds["force_n"].values[g], ds["force_t"].values[g]
     return ds["point_x"].values[g], nx * fn - ny * ft, ny * fn + nx * ft
-
-
-def all_at_rest(paths):
-    """Per pile file: at_rest, the equilibrium test's max |u_f| / (g h), residual."""
-    out = []
-    for p in paths:
-        with xr.open_dataset(p) as ds:
-            out.append((bool(ds.attrs["at_rest"]), float(ds.attrs["eq_max_velocity"]),
-                        float(ds.attrs["eq_residual"])))
-    return out

@@ -96,13 +96,3 @@ def dip_verdict(history_depth, binning_spread, exact_lo, exact_hi):
     geometry = "forced" if exact_lo > 0 else ("excluded" if exact_hi <= 0 else "allowed")
     called = bool(history_depth > 0 and history_depth > binning_spread and geometry == "forced")
     return geometry, called
-
-
-def draw_exact_band(ax, exact, d):
-    """The kernel ground pressure of the history forces and its exact range over A ∩ C
-    (``exact.nc``), abscissae in diameters ``d``."""
-    x = exact.x_kernel.values / d
-    w = float(exact.attrs["kernel_width"]) / d
-    ax.fill_between(x, exact.kernel_min.values, exact.kernel_max.values, color="tab:green", alpha=0.2, lw=0,
-                    label=f"exact range over A ∩ C (kernel σ = {w:g} d)")
-    ax.plot(x, exact.kernel_history.values, "-", color="tab:green", lw=1.2, label=f"history, kernel σ = {w:g} d")

@@ -21,7 +21,7 @@ import numpy as np
 import xarray as xr
 from scipy import stats
 
-from ncd.core.contacts import h_matrix
+from ncd.core.contacts import external_load, h_matrix
 from ncd.core.errors import InputError
 from ncd.core.scene import make_scene
 from ncd.dynamics.explore import member_rng, shard_members
@@ -241,7 +241,7 @@ def exact_rest(cell, contacts, forces, build_mu):
     the forces stay as the test from rest left them and ``exact`` is False (the slice then
     takes the loads its reference forces balance: :func:`slice_of`)."""
     mu_b = np.where(contacts.body_b == cell.n, 0.0, float(build_mu))
-    es = ExactSet(h_matrix(cell.scene, contacts), plates.external_force(cell), mu_b)
+    es = ExactSet(h_matrix(cell.scene, contacts), external_load(cell.scene, plates.plate_load(cell)), mu_b)
     raw = np.asarray(forces, float).ravel()
     refined = es.refine(raw)
     _, cone = es.fp.violations(refined)
@@ -305,7 +305,7 @@ def analyse(builds, j, cfg, mu, rng_walk, rng_of):
 def plates_bounded(cell, contacts):
     """Whether the whole cell's ``A ∩ C`` is bounded (the mobile plate closes the box above;
     a compressive loop around the period would still be a self-stress inside ``C``)."""
-    return ForcePolytope(h_matrix(cell.scene, contacts), plates.external_force(cell), contacts.mu).is_bounded()
+    return ForcePolytope(h_matrix(cell.scene, contacts), external_load(cell.scene, plates.plate_load(cell)), contacts.mu).is_bounded()
 
 
 SCALARS = {"n_contacts": "contacts kappa in the slice", "rank_H": "rank of the slice's equilibrium equations",

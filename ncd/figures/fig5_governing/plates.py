@@ -155,11 +155,13 @@ def rest_state(cell, h, settings, guess=None, check=True):
     return res.impulse / h, float(umax), p, res
 
 
-def external_force(cell):
-    """Generalized external force per mobile body, flat (3 (n + 1),): the plate's only."""
-    F = np.zeros(3 * (cell.n + 1))
-    F[3 * cell.n + 1] = -cell.force
-    return F
+def plate_load(cell):
+    """The forces applied to the cell's mobile bodies, shape (n + 1, 2): the plate's load
+    only, downwards (the cell has no gravity); the equilibrium's external force is
+    ``external_load(cell.scene, plate_load(cell))``."""
+    applied = np.zeros((cell.n + 1, 2))
+    applied[cell.n, 1] = -cell.force
+    return applied
 
 
 @dataclass
@@ -235,5 +237,5 @@ def relax(sl, guess, order, settings):
     return res.impulse / h, bool(res.converged), float(umax)
 
 
-__all__ = ["Cell", "make_cell", "cell_contacts", "prepare", "step", "rest_state", "external_force",
+__all__ = ["Cell", "make_cell", "cell_contacts", "prepare", "step", "rest_state", "plate_load",
            "Slice", "slice_problem", "relax", "PLATE_NORMAL"]

@@ -14,7 +14,7 @@ import numpy as np
 import xarray as xr
 
 from ncd.core.scene import make_scene
-from ncd.dynamics.md import MD, MDParams, critical_step, external_force
+from ncd.dynamics.md import MD, MDParams, critical_step, wall_reaction
 from ncd.dynamics.stepper import initial_guess, prepare_step, solve_problem, step
 from ncd.solver.settings import SolverSettings
 from ncd.studies import cases as scenes
@@ -129,7 +129,7 @@ def heap_observables(s, vel_before=None, h=None, md=None):
     weight = -np.sum(m) * s.gravity[1]
     if md is not None:
         c, f = md.contact_forces()
-        ry = external_force(s, c, f)[1]
+        ry = wall_reaction(s, c, f)[1]
     else:
         ry = np.sum(m * (s.vel[:nm, 1] - vel_before[:nm, 1])) / h - np.sum(m) * s.gravity[1]
     width = s.wall_point[2, 0] - s.wall_point[1, 0]
