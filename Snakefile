@@ -22,7 +22,7 @@ validate(config, str(Path(workflow.basedir) / "workflow/schemas/config.schema.ya
 # Snakemake samples the process tree of every running job (psutil's memory_full_info reads
 # /proc/<pid>/smaps_rollup) twice a second for a job's first samples, a cost of this process's
 # CPU per job.  The figures read only the benchmark files' wall time `s`, measured apart from
-# the samples, so a sample every 5 s serves (workflow/README.md).
+# the samples, so a sample ten times rarer serves (workflow/README.md).
 import snakemake.benchmark as _benchmark
 
 _benchmark.BENCHMARK_INTERVAL_SHORT = max(_benchmark.BENCHMARK_INTERVAL_SHORT, 5.0)

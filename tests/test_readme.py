@@ -3,7 +3,7 @@ numbers (it points to results/index.html and the bench page, built from the data
 stays short, its pictures exist, config/README.md is up to date, docs/solvers.md has a
 section per solver method, and neither uses words of the project's process.  Neither do
 the other guides of docs/, the comments of the configuration files and the comments of
-ncd/exact/ type measured numbers."""
+the code type measured numbers."""
 import io
 import re
 import subprocess
@@ -18,7 +18,9 @@ README = (ROOT / "README.md").read_text()
 SOLVERS = ROOT / "docs" / "solvers.md"
 DOCS = sorted((ROOT / "docs").glob("*.md"))         # markdown only: docs/speed.tsv is generated data
 CONFIGS = [ROOT / "config.yaml", *sorted((ROOT / "config").glob("*.yaml"))]
-COMMENTED = sorted((ROOT / "ncd" / "exact").glob("*.py"))
+# the code whose comments are scanned: the package, the workflow and the scripts
+COMMENTED = (sorted((ROOT / "ncd").rglob("*.py")) + [ROOT / "Snakefile"] + sorted((ROOT / "workflow").rglob("*.smk"))
+             + sorted((ROOT / "workflow" / "scripts").glob("*.py")) + sorted((ROOT / "scripts").glob("*.py")))
 MAX_LINES = 220
 
 
@@ -76,7 +78,8 @@ MEASURED = re.compile(
 def measured(name, text):
     """``name:line: match`` for every hand-typed measured number of ``text`` (a prose, or
     comments, whose lines are those of the file ``name``)."""
-    return [f"{name}:{text.count(chr(10), 0, m.start()) + 1}: {m.group(0).strip()}" for m in MEASURED.finditer(text)]
+    return [f"{name}:{k}: {m.group(0).strip()}" for k, line in enumerate(text.split("\n"), 1)
+            for m in MEASURED.finditer(line)]
 
 
 COMMIT = re.compile(r"(?<![\w-])(?=[0-9a-f]*[a-f])(?=[0-9a-f]*[0-9])[0-9a-f]{7,40}(?![\w-])")
@@ -128,7 +131,7 @@ def test_speed_table_is_the_generated_one():
 
 def test_no_measured_numbers_in_docs_config_comments_and_exact_comments():
     """The guides of docs/ (speed.tsv, generated data, is not one), the comments of
-    config.yaml and config/*.yaml, and the ``#`` comments of ncd/exact/ say why in words and
+    config.yaml and config/*.yaml, and the ``#`` comments of the code (ncd/, the workflow, scripts/) say why in words and
     point to the pages that measure: no timing, speed-up, percentage or count typed there."""
     assert SOLVERS in DOCS and all(p.suffix == ".md" for p in DOCS)
     found = []

@@ -75,7 +75,7 @@ def status_system(mu, status):
     width = np.where(stick, 2, np.where(slide, 1, 0))
     first = np.cumsum(width) - width                             # first unknown of each contact
     col = int(width.sum())
-    # per closed contact c: P[2c, x] = 1 and P[2c+1, x+1] = 1 (stick) or P[2c+1, x] = sign mu (slide)
+    # per closed contact c at column k: P[2c, k] = 1 and P[2c+1, k+1] = 1 (stick) or P[2c+1, k] = sign mu (slide)
     c = np.nonzero(width)[0]
     rows = np.column_stack([2 * c, 2 * c + 1]).ravel()
     cols = np.column_stack([first[c], first[c] + width[c] - 1]).ravel()
@@ -282,7 +282,7 @@ def polish_discs(scene, contacts, vel, spin, bias, q_free, Wb, flat, order, resu
     out = polish(make_lp, W, q_free.ravel(), contacts.mu, 1.0 / Wb[:, 0, 0], scale, s_start, status.copy(),
                  settings.finish_tol, more, settings.max_sweeps, result.sweeps)
     s = out[0]
-    if not np.array_equal(s, imp.reshape(n, 2)):       # a projection: u_f = u_free + M^-1 H s
+    if not np.array_equal(s, imp.reshape(n, 2)):       # a projection: u_f = u_free + M^{-1} H s
         body[:nm, :3] = (free + minv * (H @ s.ravel())).reshape(nm, 3)
         imp[:] = s.ravel()
     return _finished(result, *out)

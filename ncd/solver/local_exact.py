@@ -22,7 +22,7 @@ CHUNK = 100          # sweeps between stall tests
 STALL_WINDOW = 5     # chunks over which the residual must fall ...
 STALL_FACTOR = 0.5   # ... below this fraction of its value, or the region is solved exactly
 SEED = 12            # contacts that moved most over the last chunk
-MAX_REGION = 60      # contacts of a region at most (Lemke's tableau is dense: 180 x 360)
+MAX_REGION = 60      # contacts of a region at most (Lemke's tableau is dense: 3 MAX_REGION rows, twice as many columns)
 
 
 def solve_region(W, q, mu, s, idx):

@@ -82,7 +82,7 @@ def _is_point(P, r, tol):
     return bool(eq[0] <= tol and co[0] <= tol)
 
 
-MIXED_GAP, MIXED_RHAT = 0.3, 1.2   # two chains agree: eta_U within 30 %, Gelman-Rubin R-hat at most 1.2
+MIXED_GAP, MIXED_RHAT = 0.3, 1.2   # two chains agree: eta_U within a relative 0.3 of each other, Gelman-Rubin R-hat at most 1.2
 
 
 def chains_agree(gap, rhat):

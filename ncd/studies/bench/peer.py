@@ -33,7 +33,7 @@ DEFAULTS = {
     "mu": 0.5,            # Coulomb friction, every pair
     "h": 1.0e-3,          # time step (s) = 0.031 sqrt(d/g)
     "iterations": 10,     # Gauss-Seidel sweeps per step (both engines)
-    "drop_every": 64,     # steps between releases (0.064 s)
+    "drop_every": 64,     # steps between releases
     "settle": 1.0,        # s simulated after the last release
     "ground_width": 60,   # ground length, in mean diameters (>= 2)
     "root_seed": 5,       # the generator default_rng((0, root_seed))
