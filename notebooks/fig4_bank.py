@@ -71,6 +71,7 @@ import xarray as xr
 from IPython.display import Markdown, display
 
 from ncd.figures.fig4_bank import claims as bc
+from ncd.figures.fig4_bank import page as bpage
 from ncd.figures.fig4_bank import plots as bp
 from ncd.pages.claims import claim_markdown
 from ncd.pages.notebook import paths, save
@@ -102,7 +103,7 @@ display(Markdown(bp.caption(ms)))
 # %%
 tol = float(ms.attrs["vertical_tol_deg"])
 display(claim("s5-surface-parallel-vertical"))
-display(Markdown(bc.cuts_text(ms)))
+display(Markdown(bpage.cuts_text(ms)))
 
 # %% [markdown]
 # ## <a id="exact-ranges"></a>Forced by the geometry? Exact ranges over $A \cap C$
@@ -112,30 +113,30 @@ display(Markdown(bc.cuts_text(ms)))
 # surface-parallel cuts, or only the history state?
 
 # %%
-display(Markdown(bc.exact_text(exact, tol, ms)))
+display(Markdown(bpage.exact_text(exact, tol, ms)))
 
 # %% [markdown]
 # ## <a id="stress"></a>The granular stress tensor
 
 # %%
-display(Markdown(bc.stress_text(ms, exact)))
+display(Markdown(bpage.stress_text(ms, exact)))
 
 # %% [markdown]
 # ## <a id="reciprocity"></a>The reciprocity formula
 
 # %%
 display(claim("s5-reciprocity"))
-display(Markdown(bc.reciprocity_text(ms)))
+display(Markdown(bpage.reciprocity_text(ms)))
 
 # %% [markdown]
 # ## <a id="incipient-failure"></a>Incipient failure as a stress state
 
 # %%
 display(claim("s5-incipient-failure"))
-display(Markdown(bc.failure_text(ms)))
+display(Markdown(bpage.failure_text(ms)))
 
 # %% [markdown]
 # ## <a id="three-d"></a>What the 2-D measurement can and cannot say about Moreau's 3-D piles
 
 # %%
-display(Markdown(bc.three_d_text(ms)))
+display(Markdown(bpage.three_d_text(ms)))
