@@ -14,12 +14,12 @@ import numpy as np
 import xarray as xr
 
 from ncd.shared.verdict import DIFFERS, NOT_COMPUTED, REPRODUCED, Verdict
+from ncd.shared.verdict import anchor as claim_anchor
 
 MEASURES = "fig4_bank/measures.nc"
 EXACT = "fig4_bank/exact"
 CLAIM_HISTORY = "point"
 ASYMMETRY_TOL = 1e-6     # |sigma_xy - sigma_yx| / p allowed of an equilibrium solved to 1e-10 or an LP vertex
-ANCHORS = {"vertical": "surface-parallel-cuts", "reciprocity": "reciprocity", "failure": "incipient-failure"}
 
 
 def nan_stat(stat, a, *args, **kw):
@@ -88,7 +88,7 @@ def vertical_numbers(ms):
 def claim_surface_force_vertical(results):
     """"In the latter case [cuts parallel to the free surface], the transmitted force is found vertical"."""
     ms, exact = load(results)
-    anchor = ANCHORS["vertical"]
+    anchor = claim_anchor("s5-surface-parallel-vertical")
     if ms is None or CLAIM_HISTORY not in ms.history.values:
         return _missing(anchor, "Surface-parallel cuts")
     v = vertical_numbers(ms)
@@ -134,7 +134,7 @@ def claim_reciprocity(results):
     """"These two observations are mathematically equivalent thanks to a reciprocity formula ensuing
     from the symmetry of the Cauchy stress"."""
     ms, exact = load(results)
-    anchor = ANCHORS["reciprocity"]
+    anchor = claim_anchor("s5-reciprocity")
     if ms is None:
         return _missing(anchor, "The stress windows")
     r = reciprocity_numbers(ms, exact)
@@ -174,7 +174,7 @@ def claim_incipient_failure(results):
     """"... amounting to the assertion, commonly made in Civil Engineering, that the peripheral bank
     lies in a state of incipient failure"."""
     ms, _ = load(results)
-    anchor = ANCHORS["failure"]
+    anchor = claim_anchor("s5-incipient-failure")
     if ms is None or CLAIM_HISTORY not in ms.history.values:
         return _missing(anchor, "The stress windows")
     f = failure_numbers(ms)
