@@ -61,6 +61,7 @@ import xarray as xr
 from IPython.display import Markdown, display
 
 from ncd.figures.fig5_governing import claims as gc
+from ncd.figures.fig5_governing import page as gpage
 from ncd.figures.fig5_governing import plots as gp
 from ncd.figures.fig5_governing import summary as gs
 from ncd.figures.fig5_governing.claims import JUDGES
@@ -78,7 +79,7 @@ results = Path(inp.packings).parents[1]           # the results folder the claim
 
 # %%
 plates = ds.kind.values == 0
-display(Markdown(gc.study_summary(ds, cfg)))
+display(Markdown(gpage.study_summary(ds, cfg)))
 
 # %%
 med, worst, n_w = gc.walk_settling(ds)
