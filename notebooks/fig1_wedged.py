@@ -83,7 +83,6 @@ display(Markdown(claim_markdown("s1-forces-undetermined", results, JUDGES)))
 
 # %%
 display(Markdown(page.second_contact_sentence(ens, wedge)))
-display(Markdown(claim_markdown("s2-review-orders", results, JUDGES)))
 
 # %% [markdown]
 # ### Two evolutions from one state

@@ -160,7 +160,7 @@ KNOWN = {
     # the ensembles of piles (ncd.figures.fig4_history.analysis)
     "history": ("1", "construction history of the pile (point source or rain)"),
     "pile": ("1", "pile (ensemble member) index"), "flank": ("1", "flank of the pile (left or right)"),
-    # the benchmark suite (ncd.studies.bench.solver, results/bench/*.nc)
+    # the benchmark suite (ncd.studies.bench, results/bench/*.nc)
     "size": ("1", "discs of the benchmark packing"), "threads": ("1", "threads of the ensemble run"),
     "speedup": ("1", "wall time on one thread over wall time on this many threads"),
     "same_results": ("1", "outputs identical to the one-thread run, bit for bit", FLAG),

@@ -13,9 +13,11 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-REPRODUCED, DIFFERS, BEYOND, NOT_TESTED, NOT_COMPUTED = (
-    "reproduced", "differs", "beyond the paper", "not tested", "not computed")
-VERDICTS = (REPRODUCED, DIFFERS, BEYOND, NOT_TESTED, NOT_COMPUTED)
+REPRODUCED, DIFFERS, BEYOND, CONSISTENT, NOT_TESTED, NOT_COMPUTED = (
+    "reproduced", "differs", "beyond the paper", "consistent", "not tested", "not computed")
+# consistent: the sentence holds by construction of the method or is a definition (no data
+# where it is false can be built): illustrated by the run, not tested, and counted apart
+VERDICTS = (REPRODUCED, DIFFERS, BEYOND, CONSISTENT, NOT_TESTED, NOT_COMPUTED)
 
 
 @dataclass(frozen=True)

@@ -1,7 +1,6 @@
 """Figure 1's rows on the index: §1 (two evolutions, the wedging threshold, the segment of I,
-forces as state) and the §2 bound on the solutions reached by review orders.
+forces as state).
 """
-import math
 
 import numpy as np
 
@@ -79,18 +78,6 @@ def fig1_forces_as_state(results):
               "s1-forces-as-state", F1_EVOL)
 
 
-def fig1_review_orders(results):
-    ens = open_data(results, F1_ENS)
-    zero = ens.zero_guess.values.astype(bool) & ens.converged.values.astype(bool)
-    kappa = ens.sizes["contact"]
-    ends = np.unique(np.round(np.column_stack([ens.force_n.values[zero], ens.force_t.values[zero]]), 9), axis=0)
-    bound = math.factorial(kappa - 1)
-    return judged(f"κ = {kappa}: the {zero.sum()} converged zero-guess runs (both first-reviewed contacts) reach "
-              f"{len(ends)} distinct solution(s), against at most (κ − 1)! = {bound}",
-              REPRODUCED if len(ends) <= bound else DIFFERS, "distinct zero-guess limits ≤ (κ − 1)!",
-              "s2-review-orders", F1_ENS)
-
-
 # the judging functions of this package's rows, by claim id (ncd.pages.claims renders them)
 JUDGES = {
     "s1-two-evolutions": (fig1_two_evolutions,),
@@ -98,5 +85,4 @@ JUDGES = {
     "s1-forces-undetermined": (fig1_undetermined,),
     "s1-segment": (fig1_segment,),
     "s1-forces-as-state": (fig1_forces_as_state,),
-    "s2-review-orders": (fig1_review_orders,),
 }

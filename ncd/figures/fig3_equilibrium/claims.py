@@ -1,6 +1,7 @@
 """Figure 3's rows on the index: §4 (dim A, outlines, cones, ghost images, the boundary of A ∩ C,
 the exact set) and §2's equilibrium test and warm start at rest.
 """
+import math
 from functools import lru_cache
 
 import numpy as np
@@ -118,6 +119,22 @@ def fig3_exact(results):
               "s4-force-set", F3[1])
 
 
+def fig3_review_orders(results):
+    """§2: zero-guess runs with random review orders reach at most (κ − 1)! solutions, "found
+    sufficient to generate a significant outline of the solution set".  The bound is a count
+    (it holds by construction); the outline is measured: the zero-guess clouds' hull against
+    the exact projection of A ∩ C at the displayed contacts."""
+    rows, proj = _fig3_rows(results)
+    kappa = int(proj.attrs["n_contacts"])
+    cover = [r["coverage"] for r in rows if r["mode"] == "zero"]
+    ok = min(cover) >= 0.5
+    return judged(f"κ = {kappa}, (κ − 1)! = {math.factorial(kappa - 1):.3g}; the zero-guess clouds cover "
+                  f"{', '.join(pct(c) for c in cover)} of the exact projections of the displayed contacts",
+                  REPRODUCED if ok else DIFFERS,
+                  "a significant outline: the zero-guess cloud's hull covers at least half of each exact projection",
+                  "s2-review-orders", *F3)
+
+
 # the judging functions of this package's rows, by claim id (ncd.pages.claims renders them)
 JUDGES = {
     "s2-warm-accelerates": (warm_accelerates_rest,),
@@ -128,4 +145,5 @@ JUDGES = {
     "s4-ghost-images": (fig3_ghosts,),
     "s4-denser-boundary": (fig3_boundary,),
     "s4-force-set": (fig3_exact,),
+    "s2-review-orders": (fig3_review_orders,),
 }
