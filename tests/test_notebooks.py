@@ -119,3 +119,45 @@ def test_page_notebook_is_short_and_prints_no_log(name):
     body = [[ln for ln in src.splitlines() if ln.strip() and not ln.startswith(("import ", "from "))] for src in code]
     assert max(map(len, body)) <= 12, "a cell of more than 12 lines besides its imports"
     assert not any("print(" in src for src in code), f"{name} prints a log"
+
+
+def notebook_defects(nb_path):
+    """What an executed notebook shows wrongly: a figure shown twice (the cell that saves it
+    with ``show=True`` holds more than one image) or a bare return value printed (an
+    ``execute_result`` that is a plain number, e.g. the byte count of a file write)."""
+    import json
+    import re
+    bad = []
+    cells = json.loads(Path(nb_path).read_text(encoding="utf-8"))["cells"]
+    for c in cells:
+        if c["cell_type"] != "code":
+            continue
+        source, outputs = "".join(c.get("source", [])), c.get("outputs", [])
+        images = sum("image/png" in o.get("data", {}) for o in outputs)
+        if "show=True" in source and images != 1:
+            bad.append(f"{Path(nb_path).name}: {images} images in the cell that saves the figure")
+        for o in outputs:
+            text = "".join(o.get("data", {}).get("text/plain", [])) if o.get("output_type") == "execute_result" else ""
+            if re.fullmatch(r"\s*-?\d+(\.\d+)?\s*", text):
+                bad.append(f"{Path(nb_path).name}: a bare value {text.strip()!r} printed")
+    return bad
+
+
+def test_the_defect_reader_finds_a_figure_shown_twice_and_a_bare_value(tmp_path):
+    import json
+    img = {"output_type": "display_data", "data": {"image/png": "x"}}
+    cells = [{"cell_type": "code", "source": ["save(fig, out, show=True)"], "outputs": [img, img]},
+             {"cell_type": "code", "source": ["path.write_text(s)"],
+              "outputs": [{"output_type": "execute_result", "data": {"text/plain": ["601"]}}]},
+             {"cell_type": "code", "source": ["save(fig, out, show=True)"], "outputs": [img]}]
+    nb = tmp_path / "x.ipynb"
+    nb.write_text(json.dumps({"cells": cells}))
+    assert notebook_defects(nb) == ["x.ipynb: 2 images in the cell that saves the figure", "x.ipynb: a bare value '601' printed"]
+    nb.write_text(json.dumps({"cells": cells[2:]}))
+    assert notebook_defects(nb) == []
+
+
+def test_each_figure_is_shown_once_and_no_bare_value_is_printed(results):
+    """On the executed notebooks of the run (:func:`notebook_defects`)."""
+    bad = [d for nb in sorted((results / "notebooks").glob("*.ipynb")) for d in notebook_defects(nb)]
+    assert not bad, bad

@@ -21,7 +21,7 @@ from pathlib import Path
 
 import yaml
 
-from ncd.shared.verdict import NOT_COMPUTED, NOT_TESTED, Verdict, anchor
+from ncd.shared.verdict import BEYOND, CONSISTENT, DIFFERS, NOT_COMPUTED, NOT_TESTED, REPRODUCED, Verdict, anchor
 
 TABLE = Path(__file__).with_name("paper_claims.yaml")
 
@@ -74,6 +74,50 @@ def verdicts(claim_id, results, judges_by_figure):
         rows = [("", Verdict(UNTESTED_REASONS.get(claim_id, "not measured by any figure"), NOT_TESTED, "—",
                              anchor(claim_id)))]
     return rows
+
+
+RULES = {
+    "all": "every page's evidence must reproduce it",
+    "any": "a \"may\": one page's evidence reproducing it suffices",
+}
+
+
+def rule_of(claim, figures):
+    """``(counted figures, rule text)`` of a sentence: its table's ``rule`` (``all``, ``any``
+    or the one figure whose evidence is the sentence's scope) over the ``figures`` that
+    judged it; one page needs no rule."""
+    rule = claim.get("rule", "all")
+    if rule in RULES:
+        return list(figures), (RULES[rule] if len(figures) > 1 else "")
+    if rule not in figures:
+        return list(figures), RULES["all"] if len(figures) > 1 else ""
+    why = claim.get("rule_reason", "")
+    return [rule], f"{rule}'s evidence is the sentence's scope" + (f" ({why})" if why else "") + "; the others are shown"
+
+
+def sentence_verdict(claim, rows):
+    """One verdict per sentence from its ``[(figure, Verdict)]`` rows, by the claim's rule:
+    among the counted rows, any *differs* makes it differ under ``all`` (one reproducing
+    row suffices under ``any``); rows that all hold by construction are *consistent*, all
+    beyond the paper *beyond the paper*; a missing measurement leaves it *not computed*.
+    Returns ``(verdict, rule text)``."""
+    counted, text = rule_of(claim, [f for f, _ in rows])
+    got = [v.verdict for f, v in rows if f in counted]
+    if not got or got == [NOT_TESTED]:
+        return NOT_TESTED, text
+    any_rule = claim.get("rule") == "any"
+    if any_rule and REPRODUCED in got:
+        return REPRODUCED, text
+    if DIFFERS in got:
+        return DIFFERS, text
+    if NOT_COMPUTED in got:
+        return NOT_COMPUTED, text
+    if REPRODUCED in got:
+        return REPRODUCED, text
+    for kind in (CONSISTENT, BEYOND, NOT_TESTED):
+        if kind in got:
+            return kind, text
+    return got[0], text
 
 
 def claim_markdown(claim_id, results, judges):

@@ -172,6 +172,10 @@ def save(fig, output, dpi=130, show=False, **kwargs):
         from IPython.display import Image, display
 
         display(Image(filename=str(output.png)))
+        # the PNG shown is the figure: closed, the inline backend does not show it a second time
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)
 
 
 def results_dir(io):

@@ -31,8 +31,8 @@ TITLES = {
     "fig4_history_size": "Beyond the paper — Figure 4's piles against their size",
     "fig4_bank": "End of §5 — the bank of the pile: surface-parallel cuts, stress and reciprocity",
     "fig5_governing": "Beyond the paper — governing parameters of indeterminacy",
-    "stability": "Beyond the paper — stability on stiff and extreme cases",
-    "error_vs_runtime": "Beyond the paper — error against run time",
+    "stability": "§2 — stability of the implicit scheme on stiff and extreme cases, against MD",
+    "error_vs_runtime": "§2 — error against run time, and the warm start",
     "bench": "Speed report",
 }
 # pages outside the default run's list, placed after the page they extend (their links

@@ -1,11 +1,13 @@
-"""The reproduction page ``results/index.html``: every claim of the paper, section by section.
+"""The reproduction page ``results/index.html``: every sentence of the paper, section by section.
 
-The claims and the functions that judge them are in :mod:`ncd.pages.claims`; a figure's
-page prints the same :class:`~ncd.shared.verdict.Verdict` for the same claim, and each row
-links to that block (``html/<figure>.html#claim-<id>``) and to the data files it read.
-A claim no figure measures is a *not tested* row with the reason; a missing file gives
-*not computed*, never a crash, so the page builds while figures change.  Figures
-without a claim are listed with their thumbnail and run time all the same.
+The claims table and the rendering are in :mod:`ncd.pages.claims`, the functions that judge
+them in each figure's ``claims.py`` (:mod:`ncd.pages.registry`); a figure's page prints the
+same :class:`~ncd.shared.verdict.Verdict` for the same claim, and each row links to that
+block (``html/<figure>.html#claim-<id>``) and to the data files it read.  One row per
+sentence: where several pages hold evidence, the row shows each page's number and one
+verdict by the sentence's rule.  The page opens with an abstract generated from the
+verdicts.  A claim no figure measures is a *not tested* row with the reason; a missing file
+gives *not computed*, never a crash, so the page builds while figures change.
 """
 import csv
 import hashlib
@@ -15,9 +17,11 @@ from pathlib import Path
 import yaml
 
 from ncd.io.netcdf import git_commit, versions
-from ncd.pages.claims import CLAIMS, verdicts
+from ncd.pages.claims import CLAIMS, sentence_verdict, verdicts
 from ncd.pages.registry import JUDGES_BY_FIGURE
-from ncd.shared.verdict import BEYOND, DIFFERS, NOT_COMPUTED, NOT_TESTED, REPRODUCED
+from ncd.shared.verdict import BEYOND, CONSISTENT, DIFFERS, NOT_COMPUTED, NOT_TESTED, REPRODUCED
+
+UNGER = "unger2005"      # the source of the findings judged beyond the paper (Unger, Kertész & Wolf 2005)
 
 
 def run_times(results, figure):
@@ -47,27 +51,108 @@ def provenance_rows(config):
 CSS = """body{font:15px/1.45 system-ui,sans-serif;max-width:1200px;margin:2em auto;padding:0 1em;color:#222}
 table{border-collapse:collapse;width:100%;margin:1em 0}th,td{border:1px solid #ccc;padding:.4em .6em;vertical-align:top}
 th{background:#f2f2f2;text-align:left}blockquote{margin:0;font-style:italic}
-.v-reproduced{background:#e6f4e6}.v-differs{background:#fde8e0}.v-beyond{background:#e6eefa}.v-not{background:#eee;color:#666}
+.v-reproduced{background:#e6f4e6}.v-differs{background:#fde8e0}.v-beyond{background:#e6eefa}.v-consistent{background:#f4f1e0}
+.v-not{background:#eee;color:#666}.abstract{background:#f7f7f7;border:1px solid #ddd;padding:.2em 1em}
 img.thumb{width:180px;border:1px solid #ddd}.small{font-size:13px;color:#555}"""
 
 SECTIONS = (("§1", "Introductory example"), ("§2", "Time-stepping computation"), ("§3", "Granular flow on a slope"),
-            ("§4", "An equilibrium state"), ("§5", "The messages from history"), ("§6", "Conclusion"))
-VERDICT_ORDER = (REPRODUCED, DIFFERS, BEYOND, NOT_TESTED, NOT_COMPUTED)
+            ("§4", "An equilibrium state"), ("§5", "The messages from history"), ("§6", "Conclusion"),
+            (UNGER, "Beyond the paper: Unger, Kertész & Wolf (2005)"))
+VERDICT_ORDER = (REPRODUCED, DIFFERS, CONSISTENT, BEYOND, NOT_TESTED, NOT_COMPUTED)
 
 
 def _verdict_class(v):
-    return {REPRODUCED: "v-reproduced", DIFFERS: "v-differs", BEYOND: "v-beyond"}.get(v, "v-not")
+    return {REPRODUCED: "v-reproduced", DIFFERS: "v-differs", BEYOND: "v-beyond",
+            CONSISTENT: "v-consistent"}.get(v, "v-not")
 
 
 def section_of(claim):
-    """The paper section (§1–§6) a claim is filed under: the last one its label names."""
+    """The section a claim is filed under: the last paper section (§1–§6) its label names,
+    or the section of Unger et al.'s findings (a claim whose ``source`` is their paper)."""
+    if claim.get("source") == UNGER:
+        return UNGER
     found = [sec for sec, _ in SECTIONS if sec in claim["section"]]
     return found[-1] if found else SECTIONS[0][0]
 
 
 def claim_rows(results, claims=CLAIMS):
-    """``[(claim, figure, Verdict)]``: one row per claim and figure judging it."""
+    """``[(claim, figure, Verdict)]``: each page's evidence for each claim."""
     return [(c, fig, v) for c in claims for fig, v in verdicts(c["id"], results, JUDGES_BY_FIGURE)]
+
+
+def sentence_rows(results, claims=CLAIMS):
+    """``[(claim, [(figure, Verdict)], verdict, rule text)]``: one row per sentence, its
+    pages' evidence and the one verdict its rule gives (:func:`ncd.pages.claims.sentence_verdict`)."""
+    out = []
+    for c in claims:
+        rows = verdicts(c["id"], results, JUDGES_BY_FIGURE)
+        out.append((c, rows, *sentence_verdict(c, rows)))
+    return out
+
+
+def tally(sentences, source=None):
+    """``{verdict: count}`` over the sentences of the paper (``source`` None) or of another
+    source (``UNGER``): one count per sentence, whatever the number of pages judging it."""
+    counts = {v: 0 for v in VERDICT_ORDER}
+    for c, _, verdict, _ in sentences:
+        if c.get("source") == source:
+            counts[verdict] += 1
+    return counts
+
+
+def _short(quote, words=12):
+    w = quote.split()
+    return " ".join(w[:words]) + (" …" if len(w) > words else "")
+
+
+def abstract(sentences):
+    """The findings first, generated from the verdicts: how many sentences reproduce, which
+    differ and by what measured value, how many hold by construction or are not tested, the
+    pairs of sentences whose verdicts pull apart (the table's ``see``) with both measured
+    values, and Unger et al.'s findings at this run's size."""
+    e = html.escape
+    counts = tally(sentences)
+    by_id = {c["id"]: (c, rows, v) for c, rows, v, _ in sentences}
+    parts = [f"Of the {sum(counts.values())} checkable sentences of the paper, {counts[REPRODUCED]} reproduce, "
+             f"{counts[DIFFERS]} differ, {counts[CONSISTENT]} hold by construction (consistent: illustrated, not "
+             f"tested), {counts[BEYOND]} are questions the paper leaves open (measured, not judged), "
+             f"{counts[NOT_TESTED]} are not tested and {counts[NOT_COMPUTED]} were not computed in this run."]
+    differ = [(c, rows) for c, rows, v, _ in sentences if v == DIFFERS and c.get("source") is None]
+    if differ:
+        items = "".join(f"<li><a href='#{e(c['id'])}'>{e(c['section'])}</a> “{e(_short(c['quote']))}”: "
+                        + "; ".join(e(v.value) for _, v in rows if v.verdict == DIFFERS) + "</li>"
+                        for c, rows in differ)
+        parts.append(f"<b>What differs, and the measured reason</b>:<ul>{items}</ul>")
+    pulls = []
+    for c, rows, v, _ in sentences:
+        for other in c.get("see", []):
+            if other in by_id and by_id[other][2] != v and other not in [p for p, _ in pulls]:
+                o, orows, ov = by_id[other]
+                pulls.append((c["id"], f"<li><a href='#{e(c['id'])}'>{e(c['section'])}</a> ({e(v)}) and "
+                                       f"<a href='#{e(other)}'>{e(o['section'])}</a> ({e(ov)}): "
+                                       + " — ".join(e(r.value) for _, r in rows + orows) + "</li>"))
+    if pulls:
+        parts.append(f"<b>Verdicts that pull apart</b>, with what each measured:<ul>{''.join(p for _, p in pulls)}</ul>")
+    unger = tally(sentences, UNGER)
+    if sum(unger.values()):
+        parts.append("Beyond the paper, the findings of Unger, Kertész &amp; Wolf at this run's size: "
+                     + ", ".join(f"{k} {e(v)}" for v, k in unger.items() if k) + ".")
+    return "<div class='abstract'><p>" + "</p><p>".join(parts) + "</p></div>"
+
+
+def _row(c, evidence, verdict, rule):
+    """One table row: a sentence, each page's evidence, the one verdict and its rule."""
+    e = html.escape
+    where = "<br>".join(f"<a href='html/{fig}.html#{e(m.anchor)}'>{e(fig)}</a>" for fig, m in evidence if fig) or "—"
+    several = len(evidence) > 1
+    measured = "<br><br>".join((f"<b>{e(fig)}</b>: " if several else "") + e(m.value) + "<br>"
+                               + "<br>".join(f"<a class='small' href='{e(d)}'>{e(d)}</a>" for d in m.data)
+                               for fig, m in evidence)
+    criteria = "<br>".join((f"{e(fig)} ({e(m.verdict)}): " if several else "") + e(m.criterion) for fig, m in evidence)
+    rule_text = f"<br><span class='small'><i>rule:</i> {e(rule)}</span>" if rule else ""
+    return (f"<tr class='{_verdict_class(verdict)}' id='{e(c['id'])}'><td>{where}<br>"
+            f"<span class='small'>{e(c['section'])}</span></td><td><blockquote>“{e(c['quote'])}”</blockquote></td>"
+            f"<td>{measured}</td><td><b>{e(verdict)}</b>{rule_text}<br><span class='small'>{criteria}</span></td></tr>")
 
 
 def build_page(results, figures, config, claims=CLAIMS):
@@ -80,48 +165,40 @@ def build_page(results, figures, config, claims=CLAIMS):
             return ""
         return f'<a href="html/{fig}.html"><img class="thumb" src="figures/{fig}.png" alt="{fig}"></a>'
 
-    measured = claim_rows(results, claims)
+    sentences = sentence_rows(results, claims)
     body = []
     for sec, title in SECTIONS:
-        rows = []
-        for c, fig, m in measured:
-            if section_of(c) != sec:
-                continue
-            where = (f"<a href='html/{fig}.html#{e(m.anchor)}'>{e(fig)}</a>" if fig else "—")
-            data = "<br>".join(f"<a class='small' href='{e(d)}'>{e(d)}</a>" for d in m.data)
-            rows.append(f"<tr class='{_verdict_class(m.verdict)}' id='{e(c['id'])}'><td>{where}<br>"
-                        f"<span class='small'>{e(c['section'])}</span></td>"
-                        f"<td><blockquote>“{e(c['quote'])}”</blockquote></td><td>{e(m.value)}<br>{data}</td>"
-                        f"<td><b>{e(m.verdict)}</b><br><span class='small'>{e(m.criterion)}</span></td>"
-                        f"<td>{thumb(fig)}</td></tr>")
+        rows = [_row(*s) for s in sentences if section_of(s[0]) == sec]
         if rows:
-            body.append(f"<h2>{e(sec)} {e(title)}</h2><table><tr><th>page</th><th>the paper says</th>"
-                        f"<th>measured in this run (data)</th><th>verdict (criterion)</th><th></th></tr>"
+            what = "the finding" if sec == UNGER else "the paper says"
+            body.append(f"<h2>{'' if sec == UNGER else e(sec) + ' '}{e(title)}</h2><table><tr><th>page</th>"
+                        f"<th>{what}</th><th>measured in this run (data)</th><th>verdict (criterion)</th></tr>"
                         f"{''.join(rows)}</table>")
     figs = []
     total = 0.0
     for fig in figures:
         jobs, secs = run_times(results, fig)
         total += secs
-        n_claims = sum(f == fig for _, f, _ in measured)
+        n_claims = sum(any(f == fig for f, _ in evidence) for _, evidence, _, _ in sentences)
         figs.append(f"<tr><td><a href='html/{fig}.html'>{e(fig)}</a></td><td>{n_claims}</td><td>{jobs}</td>"
                     f"<td>{secs:.1f}</td><td>{thumb(fig)}</td></tr>")
     prov = "".join(f"<tr><th>{e(k)}</th><td><code>{e(str(v))}</code></td></tr>" for k, v in provenance_rows(config))
-    counts = {v: 0 for v in VERDICT_ORDER}
-    for _, _, m in measured:
-        counts[m.verdict] += 1
+    counts = tally(sentences)
     summary = ", ".join(f"{n} {v}" for v, n in counts.items() if n)
     return f"""<!DOCTYPE html><html lang="en"><head><meta charset="utf-8">
 <title>ncd: reproduction of Moreau (2005), claim by claim</title><style>{CSS}</style></head><body>
 <h1>Indetermination in the numerical simulation of granular systems — reproduced claim by claim</h1>
 <p>J. J. Moreau, <i>Indetermination in the numerical simulation of granular systems</i>, Powders and Grains
-2005 (<a href="https://hal.science/hal-01824602">hal-01824602</a>). Every checkable sentence of the paper has a row
-({len(claims)} sentences, table <code>ncd/pages/paper_claims.yaml</code>). Every number is read from this run's data
-when the page is built, by the same function that writes the claim on its figure's page; the page link goes to that
-paragraph, the data links to the files read.</p>
-<p><b>Verdicts:</b> {e(summary)}. <span class="small">reproduced: the paper's statement holds by the criterion
-given; differs: it does not; beyond the paper: a measurement the paper could not make (an open question or an exact
-set); not tested: no figure measures it (the reason is given).</span></p>
+2005 (<a href="https://hal.science/hal-01824602">hal-01824602</a>). Every checkable sentence of the paper has one row
+({sum(counts.values())} sentences, table <code>ncd/pages/paper_claims.yaml</code>). Every number is read from this
+run's data when the page is built, by the same function that writes the claim on its figure's page; the page link
+goes to that paragraph, the data links to the files read.</p>
+{abstract(sentences)}
+<p><b>Verdicts, one per sentence of the paper:</b> {e(summary)}. <span class="small">reproduced: the paper's
+statement holds by the criterion given; differs: it does not; consistent: it holds by construction of the method or
+is a definition (illustrated, not tested); beyond the paper: a measurement the paper could not make (an open
+question or an exact set); not tested: no figure measures it (the reason is given). Where several pages hold
+evidence, the row shows each page's number and one verdict by the stated rule.</span></p>
 {''.join(body)}
 <h2>Figures and run time</h2>
 <p class="small">Run time: the sum of the wall times of the figure's jobs
