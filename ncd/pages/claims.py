@@ -120,6 +120,13 @@ def sentence_verdict(claim, rows):
     return got[0], text
 
 
+def criterion_of(claim, verdict):
+    """The criterion a page prints for a claim: the one stated beside the quote in the table
+    (``criterion``: what is measured, over which set, the threshold and its reason), written
+    before the data were looked at, else the judging function's own words."""
+    return claim.get("criterion") or verdict.criterion
+
+
 def claim_markdown(claim_id, results, judges):
     """The block a figure's page prints for one claim, judged by the page's own table
     ``judges`` (its package's ``JUDGES``): the anchor the index links to, the quote, the
@@ -130,5 +137,5 @@ def claim_markdown(claim_id, results, judges):
     rows = [evaluate(fn, results, claim_id) for fn in judges[claim_id]]
     own = anchor(claim_id)
     body = "\n\n".join((f'<a id="{v.anchor}"></a>' if v.anchor and v.anchor != own else "")
-                       + f"**{v.verdict}** — {v.value}. *Criterion:* {v.criterion}." for v in rows)
+                       + f"**{v.verdict}** — {v.value}. *Criterion:* {criterion_of(claim, v).rstrip('.')}." for v in rows)
     return f'<a id="{own}"></a>\n\n> {claim["section"]}: “{claim["quote"]}”\n\n{body}\n'

@@ -148,7 +148,8 @@ def _row(c, evidence, verdict, rule):
     measured = "<br><br>".join((f"<b>{e(fig)}</b>: " if several else "") + e(m.value) + "<br>"
                                + "<br>".join(f"<a class='small' href='{e(d)}'>{e(d)}</a>" for d in m.data)
                                for fig, m in evidence)
-    criteria = "<br>".join((f"{e(fig)} ({e(m.verdict)}): " if several else "") + e(m.criterion) for fig, m in evidence)
+    criteria = ("<br>".join((f"{e(fig)} ({e(m.verdict)}): " if several else "") + e(m.criterion) for fig, m in evidence)
+                if not c.get("criterion") else e(c["criterion"]))
     rule_text = f"<br><span class='small'><i>rule:</i> {e(rule)}</span>" if rule else ""
     return (f"<tr class='{_verdict_class(verdict)}' id='{e(c['id'])}'><td>{where}<br>"
             f"<span class='small'>{e(c['section'])}</span></td><td><blockquote>“{e(c['quote'])}”</blockquote></td>"

@@ -233,17 +233,24 @@ def run_table(cfg, log=None):
     return ds.assign_coords(run=np.arange(ds.sizes["run"]))
 
 
-def binary_collision(e=0.5, h=1e-3):
-    """One Moreau–Jean step of a binary collision at normal restitution ``e`` (§2: the weighted
-    mean of u_i and u_f in the contact law is Newton's law for a binary collision): the ratio
-    U_f/U_i of the normal relative velocity, −e when the scheme holds.  Written by the
-    stability rule, so that the §2 restitution claim reads data, not a step at render time."""
-    scene = make_scene([[0.0, 0.0], [0.8, 0.0]], [0.5, 0.3], [1.0, 3.0], gravity=(0.0, 0.0),
-                       vel=[[1.0, 0.0], [-0.5, 0.0]], e_n=e, mu=0.0)
-    n = prepare_step(scene, h).contacts.normal[0]
-    u_i = float((scene.vel[0] - scene.vel[1]) @ n)
-    step(scene, h)
-    u_f = float((scene.vel[0] - scene.vel[1]) @ n)
+def binary_collision(e=(0.0, 0.5), h=1e-3):
+    """One Moreau–Jean step of a binary collision at each normal restitution of ``e`` (§2: with
+    the contact law on u_f alone, e = 0, collisions are perfectly inelastic; the weighted mean
+    of u_i and u_f is Newton's law for a binary collision): the ratio U_f/U_i of the normal
+    relative velocity over ``restitution``, −e when the scheme holds.  Written by the stability
+    rule, so that the §2 restitution claims read data, not a step at render time."""
+    es = np.atleast_1d(np.asarray(e, dtype=float))
+    ratios = []
+    for e_n in es:
+        scene = make_scene([[0.0, 0.0], [0.8, 0.0]], [0.5, 0.3], [1.0, 3.0], gravity=(0.0, 0.0),
+                           vel=[[1.0, 0.0], [-0.5, 0.0]], e_n=float(e_n), mu=0.0)
+        n = prepare_step(scene, h).contacts.normal[0]
+        u_i = float((scene.vel[0] - scene.vel[1]) @ n)
+        step(scene, h)
+        u_f = float((scene.vel[0] - scene.vel[1]) @ n)
+        ratios.append(u_f / u_i)
     return xr.Dataset(
-        {"velocity_ratio": ((), u_f / u_i, {"units": "1", "long_name": "U_f / U_i of the normal relative velocity"})},
-        attrs={"restitution": e, "h": h})
+        {"velocity_ratio": ("restitution", np.array(ratios),
+                            {"units": "1", "long_name": "U_f / U_i of the normal relative velocity after one step"})},
+        coords={"restitution": ("restitution", es, {"units": "1", "long_name": "normal restitution coefficient e"})},
+        attrs={"h": h})
