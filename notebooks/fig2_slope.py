@@ -78,6 +78,7 @@ save(page.plot(traj, ens, meas, cfg), _smk.output, dpi=100, show=True)
 
 # %%
 display(Markdown(page.flow_sentence(traj, cfg)))
+display(Markdown(claim_markdown("s3-overall-acceleration", results, JUDGES)))
 
 # %% [markdown]
 # ## True indeterminacy or iteration error?
@@ -113,6 +114,7 @@ cloud = sa.cloud_against_census(ens, census, int(meas.attrs["grain"]), "zero")
 display(Markdown(page.solutions_sentence(meas, cfg) + "\n\n" + cs.census_text(census) + "\n\n"
                  + cs.cloud_text(cloud, int(meas.attrs["grain"]), float(ens.tol.min()), cfg["analysis"]["line_ratio"])))
 display(Markdown(claim_markdown("s3-line", results, JUDGES)))
+display(Markdown(claim_markdown("s2-random-guess-any-solution", results, JUDGES)))
 
 # %% [markdown]
 # ## Where the alternative is decided

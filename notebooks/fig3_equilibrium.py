@@ -116,6 +116,7 @@ display(Markdown(ep.measures_table(r) + "\n\n" + ep.findings_text(r)))
 # %%
 display(Markdown(claim_markdown("s4-outlines", results, JUDGES)))
 display(Markdown(claim_markdown("s2-review-orders", results, JUDGES)))
+display(Markdown(claim_markdown("s2-limit-depends-on-order", results, JUDGES)))
 
 # %%
 display(Markdown(claim_markdown("s2-warm-accelerates", results, JUDGES)))

@@ -134,6 +134,9 @@ display(Markdown(pp.cloud_text(r) + "\n\n" + pp.tolerance_text(r, data["toleranc
 display(Markdown(claim_markdown("s5-cloud", results, JUDGES)))
 
 # %%
+display(Markdown(claim_markdown("s5-cloud-from-ignoring-antecedent", results, JUDGES)))
+
+# %%
 display(Markdown(claim_markdown("s5-cut-position", results, JUDGES)))
 
 # %% [markdown]
@@ -171,6 +174,9 @@ display(Markdown(pp.pressure_text(r) + "\n\n" + pp.dip_sentence(data["exact"])))
 
 # %%
 display(Markdown(claim_markdown("s5-pressure-not-height", results, JUDGES)))
+
+# %%
+display(Markdown(claim_markdown("s5-arching-supports-weight", results, JUDGES)))
 
 # %%
 display(Markdown(claim_markdown("s5-dip", results, JUDGES)))

@@ -106,26 +106,21 @@ save(fig, out, dpi=110)
 # verdict (the same objects the index page prints).
 
 # %%
-def show(anchor, title, v, extra=""):
-    display(Markdown(f'<a id="{anchor}"></a>\n\n**{title}** {v.value}. *{v.verdict}* ({v.criterion}). {extra}'))
-
-
 m_u, lo_u, hi_u = gc.peak(ds, "eta_uniform")
 m_x, lo_x, hi_x = gc.peak(ds, "eta_exact")
 flat = [m for m in np.unique(ds.mu.values[plates]) if (ds.dim_AC_rank.values[plates & (ds.mu.values == m)] == 0).all()]
-show("unger-peak", "Peak near μ = 0.1.", gc.claim_unger_peak(results),
-     f"Every slice built at μ = {', '.join(f'{m:.3g}' for m in flat) or 'none'} is determinate (η_U = 0, "
-     f"off the log axes of panel a). On the uniform sample the largest η_U is at μ = {m_u:.3g} (band {lo_u:.3g}–{hi_u:.3g}); the exact range "
-     f"ratio is largest at μ = {m_x:.3g} (band {lo_x:.3g}–{hi_x:.3g}).")
-show("unger-vanishes", "η → 0 as μ → 0, η ∝ μ, z isostatic.", gc.claim_unger_vanishes(results),
-     f"Slope on the uniform sample {gc.small_mu_slope(ds, 'eta_uniform'):.2f}, of the exact range ratio "
-     f"{gc.small_mu_slope(ds, 'eta_exact'):.2f}.")
-show("unger-control", "Control series rises monotonically.", gc.claim_unger_control(results))
-n_c, closer, rank = gc.centrality_summary(ds)
 spread = (ds.walk_distance / ds.uniform_distance).where((ds.mixed == 1) & (ds.dim_AC_rank > 0)).values
-show("unger-centrality", "History state near the centre.", gc.claim_unger_centrality(results),
-     f"The random-walk samples stay at a median {np.nanmedian(spread):.2f} of the uniform samples' distance to "
-     "the centre (indeterminate slices whose chains agree)." if np.isfinite(spread).any() else "")
+extra = {
+    "unger-peak": f"Every slice built at μ = {', '.join(f'{m:.3g}' for m in flat) or 'none'} is determinate (η_U = 0, "
+    f"off the log axes of panel a). On the uniform sample the largest η_U is at μ = {m_u:.3g} (band {lo_u:.3g}–{hi_u:.3g}); "
+    f"the exact range ratio is largest at μ = {m_x:.3g} (band {lo_x:.3g}–{hi_x:.3g}).",
+    "unger-vanishes": f"Slope on the uniform sample {gc.small_mu_slope(ds, 'eta_uniform'):.2f}, of the exact range "
+    f"ratio {gc.small_mu_slope(ds, 'eta_exact'):.2f}.",
+    "unger-centrality": f"The random-walk samples stay at a median {np.nanmedian(spread):.2f} of the uniform samples' "
+    "distance to the centre (indeterminate slices whose chains agree)." if np.isfinite(spread).any() else ""}
+display(Markdown(claim_markdown("s4-unger", results, JUDGES)))
+for claim_id in gc.UNGER_CLAIMS:
+    display(Markdown(claim_markdown(claim_id, results, JUDGES) + "\n" + extra.get(claim_id, "")))
 
 # %%
 verdicts = [gc.claim_unger_peak(results), gc.claim_unger_vanishes(results), gc.claim_unger_control(results)]
@@ -142,6 +137,7 @@ Path(getattr(out, "caption", Path(inp.packings).with_name("caption.rst"))).write
 # one frictionless packing, only the friction of the analysis changes).
 
 # %%
+n_c, closer, rank = gc.centrality_summary(ds)
 n_k, closer_k, rank_k = gc.centrality_summary(ds, kind=1)
 display(Markdown(
     f"Small-μ slope of η_U on the walk: {gc.small_mu_slope(ds):.2f} over new packings at each μ, "

@@ -82,6 +82,7 @@ display(Markdown(claim_markdown("s2-stability", results, JUDGES)))
 
 # %%
 display(Markdown(page.chain_sentence(tab)))
+display(Markdown(claim_markdown("s2-inelastic", results, JUDGES)))
 display(Markdown(claim_markdown("s2-restitution", results, JUDGES)))
 
 # %% [markdown]

@@ -281,4 +281,4 @@ def test_claims_and_page(results):
         assert at > 0, claim_id
         block = html_lib.unescape(re.sub(r"<[^>]+>", "", html[at:at + 20000]))
         assert v.verdict in block and v.value[:60] in block, claim_id
-    assert bank_claims.claim_reciprocity(results).verdict == "reproduced"
+    assert bank_claims.claim_reciprocity(results).verdict == "consistent"

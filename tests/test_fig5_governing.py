@@ -272,10 +272,12 @@ def test_walk_samples_are_inside_the_exact_ranges(packings):
 
 
 def test_claims_are_measured(results):
-    from ncd.shared.verdict import NOT_TESTED, VERDICTS
-    for claim in (gc.claim_unger_peak, gc.claim_unger_vanishes, gc.claim_unger_control, gc.claim_unger_centrality):
+    from ncd.shared.verdict import BEYOND, CONSISTENT, NOT_TESTED, VERDICTS
+    for claim_id, claim in gc.UNGER_CLAIMS.items():
         v = claim(results)
-        assert v.verdict in VERDICTS[:2] + (NOT_TESTED,) and v.anchor.startswith("unger-") and "nan" not in v.value
+        assert v.verdict in VERDICTS[:2] + (NOT_TESTED, BEYOND) and v.anchor == f"claim-{claim_id}", (claim_id, v)
+        assert "nan" not in v.value
+    assert gc.claim_unger_citation(results).verdict == CONSISTENT
 
 
 def test_wedged_disc_is_unbounded():

@@ -37,7 +37,7 @@ def test_every_claim_is_judged_or_has_a_reason():
         figs = [f for f, _ in C.measures_of(c["id"], JUDGES_BY_FIGURE)]
         assert figs or c["id"] in C.UNTESTED_REASONS, c["id"]
         assert sorted(set(figs)) == sorted(c["figures"]), (c["id"], figs, c["figures"])
-        assert section_of(c) in c["section"]
+        assert section_of(c) in c["section"] or (c.get("source") == UNGER and section_of(c) == UNGER)
     known = set(JUDGES_BY_FIGURE)
     assert {f for c in C.CLAIMS for f in c["figures"]} <= known
 

@@ -8,6 +8,7 @@ from ncd.figures.fig4_bank.claims import (
     exact_summary,
     failure_numbers,
     nan_stat,
+    observation_correlation,
     of_history,
     reciprocity_numbers,
     vertical_numbers,
@@ -105,9 +106,7 @@ def reciprocity_text(ms):
     dev = of_history(ms, "vertical_deviation", h)
     ang = of_history(ms, "angle_to_vertical", h)
     a, b = of_history(ms, "reciprocity_vertical", h), of_history(ms, "reciprocity_surface", h)
-    da, db = of_history(ms, "direct_vertical", h), of_history(ms, "direct_surface", h)
-    ok = np.isfinite(a)
-    corr = float(np.corrcoef(da[ok & np.isfinite(da)], db[ok & np.isfinite(db)])[0, 1]) if ok.sum() > 2 else np.nan
+    corr, _ = observation_correlation(ms, h)
     return (f"On the point-source piles the two observations, each read from its own cut: the vertical cut's "
             f"resultant deviates from the flank slope by {nan_stat(np.nanmedian, dev):+.1f}° on median (half between "
             f"{nan_stat(np.nanquantile, dev, 0.25):+.1f}° and {nan_stat(np.nanquantile, dev, 0.75):+.1f}°), the "

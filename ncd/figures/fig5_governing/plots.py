@@ -8,7 +8,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from ncd.figures.fig5_governing.measure import eta_table, mixed_only
-from ncd.figures.fig5_governing.summary import factor_table, line_counts
+from ncd.figures.fig5_governing.summary import factor_table, fraction_table, line_counts
 from ncd.figures.fig5_governing.unger import eta_curve
 
 UNGER_PEAK_MU = 0.1     # Unger, Kertész & Wolf (2005): eta peaks near mu = 0.1, eta ∝ mu below
@@ -110,14 +110,14 @@ FACTOR_LABEL = {"mu": ("μ", "linear"), "h": ("h (s)", "log"), "slope": ("slope 
 
 
 def panel_flows(ax, flows, factor, letter):
-    """Fraction of indeterminate scanned steps (left) and the mean largest spread of a grain's
-    acceleration (right, / |g|) against one factor, 95 % bands over the seeds."""
+    """Fraction of indeterminate steps among those of known outcome (left, 95 % Wilson interval
+    over the steps, seeds pooled) and the mean largest spread of a grain's acceleration (right,
+    / |g|, 95 % band over the seeds) against one factor."""
     label, scale = FACTOR_LABEL[factor]
-    t = factor_table(flows, factor, "indeterminate")
-    band = np.nan_to_num(t[:, 2])
-    ax.errorbar(t[:, 0], t[:, 1], yerr=[np.minimum(band, t[:, 1]), np.minimum(band, 1 - t[:, 1])], marker="o",
-                color="C0", capsize=3, label="indeterminate steps")
-    u = factor_table(flows, factor, "unknown")
+    t = fraction_table(flows, factor, "indeterminate")
+    ax.errorbar(t[:, 0], t[:, 1], yerr=[t[:, 1] - t[:, 2], t[:, 3] - t[:, 1]], marker="o",
+                color="C0", capsize=3, label="indeterminate steps (95 % Wilson)")
+    u = fraction_table(flows, factor, "unknown")
     ax.plot(u[:, 0], u[:, 1], "x:", color="0.5", label="unknown (unconverged)")
     ax.set(xscale=scale, xlabel=label, ylabel="fraction of scanned steps", ylim=(-0.02, 1.02),
            title=f"({letter}) flows against {label.split()[0]}")
@@ -147,9 +147,9 @@ def panel_line(ax, flows, letter):
     x = np.arange(3)
     ax.bar(x - 0.2, [int(((rank == r) & pred).sum()) for r in x], 0.4, label="cluster with 1 degree of freedom")
     ax.bar(x + 0.2, [int(((rank == r) & ~pred).sum()) for r in x], 0.4, label="cluster with more")
-    c = line_counts(flows)
+    tc = line_counts(flows)["tested"]          # the verdict's numbers (s3-line): steps where it can fail
     ax.set(xticks=x, xticklabels=["point", "line", "area"], ylabel="indeterminate steps",
-           title=f"({letter}) why a line: holds at {c['holds']} of {c['steps']}")
+           title=f"({letter}) why a line: holds at {tc['holds']} of {tc['steps']}\n(steps with 3 solutions or more)")
     _legend(ax)
 
 

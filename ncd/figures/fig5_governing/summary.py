@@ -2,7 +2,9 @@
 
 :func:`flow_measures` (per flow: fraction of indeterminate steps, mean spread, distance
 between solutions), :func:`factor_table` (per setting of one factor, with a 95 % t-band
-over seeds) and :func:`line_counts` (cloud ranks and how often the cluster hypothesis of
+over seeds, for the continuous measures), :func:`fraction_table` (a fraction of scanned steps
+per setting with its 95 % Wilson interval over the steps: two seeds give no usable t-band
+of a fraction) and :func:`line_counts` (cloud ranks and how often the cluster hypothesis of
 :mod:`ncd.figures.fig5_governing.line` holds).
 """
 import numpy as np
@@ -50,6 +52,39 @@ def factor_table(ds, factor, measure):
     return np.array(rows, float).reshape(-1, 4)
 
 
+def wilson(k, n, z=1.959964):
+    """``(lo, hi)``: the 95 % Wilson score interval of ``k`` successes in ``n`` trials (NaN for
+    ``n = 0``); it stays inside [0, 1] and is not empty at ``k = 0`` or ``k = n``."""
+    if n <= 0:
+        return np.nan, np.nan
+    p = k / n
+    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z * np.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return float(max(centre - half, 0.0)), float(min(centre + half, 1.0))
+
+
+def fraction_table(ds, factor, measure="indeterminate"):
+    """Rows ``(value, fraction, 95 % Wilson lo, hi, steps counted k, of n, flows)`` for the settings
+    varying ``factor`` and the base, sorted by the value, the steps of every seed pooled:
+    ``indeterminate`` counts the indeterminate steps among those of known outcome,
+    ``unknown`` the steps of unknown outcome among all scanned steps."""
+    ind = ds.indeterminate.values
+    fac = ds.factor.values
+    use = (fac == 0) | (fac == FACTORS.index(factor))
+    x = ds[FACTOR_VAR[factor]].values
+    rows = []
+    for v in np.unique(x[use]):
+        f = use & np.isclose(x, v)
+        if measure == "indeterminate":
+            k, n = int((ind[f] == 1).sum()), int((ind[f] >= 0).sum())
+        elif measure == "unknown":
+            k, n = int((ind[f] == -1).sum()), int(ind[f].size)
+        else:
+            raise ValueError(f"fraction_table: measure {measure!r} is not a fraction of steps")
+        rows.append((v, k / n if n else np.nan, *wilson(k, n), k, n, int(f.sum())))
+    return np.array(rows, float).reshape(-1, 7)
+
+
 def line_counts(ds):
     """Counts over the indeterminate steps of every flow: cloud ranks, predictions and agreement.
 
@@ -78,7 +113,7 @@ def line_counts(ds):
             "tested": tested}
 
 
-__all__ = ["FACTOR_VAR", "flow_measures", "factor_table", "line_counts"]
+__all__ = ["FACTOR_VAR", "flow_measures", "factor_table", "wilson", "fraction_table", "line_counts"]
 
 
 def flows_overview(flows, fc):
@@ -103,15 +138,17 @@ def flows_overview(flows, fc):
 
 
 def factor_text(flows):
-    """The fraction of indeterminate steps against each factor (mean ± 95 % band over seeds)."""
+    """The fraction of indeterminate steps against each factor, with its 95 % Wilson interval
+    over the steps of known outcome (every seed's steps pooled)."""
     rows = []
     for factor, name, unit in (("mu", "μ", ""), ("h", "h", " s"), ("slope", "slope", "°")):
-        ti, ts = factor_table(flows, factor, "indeterminate"), factor_table(flows, factor, "spread")
-        tu = factor_table(flows, factor, "unknown")
-        cells = "; ".join(f"{name} = {v:g}{unit}: {m:.2f} ± {np.nan_to_num(b):.2f} (spread {s:.2g} |g|, "
-                          f"unknown {u:.2f}, {int(n)} flows)"
-                          for (v, m, b, n), (_, s, _, _), (_, u, _, _) in zip(ti, ts, tu))
-        rows.append(f"**Against {name}** — fraction of indeterminate steps (mean ± 95 % band over seeds): {cells}.")
+        ti, ts = fraction_table(flows, factor, "indeterminate"), factor_table(flows, factor, "spread")
+        tu = fraction_table(flows, factor, "unknown")
+        cells = "; ".join(f"{name} = {v:g}{unit}: {f:.2f} ({lo:.2f}–{hi:.2f}; {int(k)} of {int(n)} steps; spread "
+                          f"{s:.2g} |g|, unknown {u:.2f}, {int(nf)} flows)"
+                          for (v, f, lo, hi, k, n, nf), (_, s, _, _), (_, u, *_) in zip(ti, ts, tu))
+        rows.append(f"**Against {name}** — fraction of indeterminate steps among those of known outcome (95 % "
+                    f"Wilson interval over the steps, seeds pooled): {cells}.")
     return ("\n\n".join(rows))
 
 
