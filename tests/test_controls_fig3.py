@@ -20,7 +20,7 @@ from ncd.core.contacts import external_load, h_matrix
 from ncd.core.scene import make_scene
 from ncd.exact.polytope import ForcePolytope
 from ncd.figures.fig3_equilibrium import claims as cl
-from ncd.figures.fig3_equilibrium import faces
+from ncd.figures.fig3_equilibrium import faces, probes
 from ncd.figures.fig3_equilibrium import measure as fe
 from ncd.figures.fig3_equilibrium.packing import rest_problem
 from ncd.shared.verdict import BEYOND, DIFFERS, REPRODUCED
@@ -117,7 +117,7 @@ def test_warm_start_at_rest_controls(tmp_path):
 
 # ------------------------------------------------------------------ s2-equilibrium-test
 def test_equilibrium_test_agrees_with_the_lp_on_a_packing(tmp_path, mini):
-    v = cl.equilibrium_test(write(tmp_path, state=mini["state"]))
+    v = cl.equilibrium_test(write(tmp_path, probes=probes.probe_dataset(mini["state"])))
     assert v.verdict == REPRODUCED, v.value
     assert "the packing: u_f = 0, A ∩ C ≠ ∅" in v.value and "lifted by half its radius" in v.value
     assert "μ = 0.9 μ*" in v.value and "A ∩ C = ∅" in v.value and "8 of 8 steps" in v.value
@@ -146,7 +146,7 @@ def roof_state(beta_deg=20.0, mu=0.75, radius=0.01):
 
 def test_equilibrium_test_differs_on_a_wedged_disc(tmp_path):
     """An equilibrium the step from the zero guess calls a fall: the sentence is false there."""
-    v = cl.equilibrium_test(write(tmp_path, state=roof_state()))
+    v = cl.equilibrium_test(write(tmp_path, probes=probes.probe_dataset(roof_state())))
     assert v.verdict == DIFFERS
     assert "the packing: u_f = 0 from the warm guess only, A ∩ C ≠ ∅" in v.value, v.value
 

@@ -89,6 +89,26 @@ rule fig3_equilibrium_projection:
         "../scripts/fig3_equilibrium_projection.py"
 
 
+rule fig3_equilibrium_probes:
+    """The one-step equilibrium test against the LP on positions in and out of equilibrium
+    around the packing (ncd.figures.fig3_equilibrium.probes): data for the §2 claim."""
+    input:
+        state=f"{F3}/state.nc",
+        code=code_of("fig3_equilibrium_probes"),
+    output:
+        f"{F3}/probes.nc",
+    params:
+        config=without_shards(CFG),
+    log:
+        log(FIG, "probes"),
+    benchmark:
+        bench(FIG, "probes")
+    conda:
+        CONDA_ENV
+    script:
+        "../scripts/fig3_equilibrium_probes.py"
+
+
 rule fig3_equilibrium_uniform:
     input:
         state=f"{F3}/state.nc",
@@ -113,6 +133,7 @@ rule fig3_equilibrium_notebook:
         ensemble=f"{F3}/ensemble.nc",
         projection=f"{F3}/projection.nc",
         uniform=f"{F3}/uniform.nc",
+        probes=f"{F3}/probes.nc",
         notebook=notebook_file(FIG),
         notebook_py=notebook_file(FIG, "py"),
         code=notebook_code("fig3_equilibrium"),

@@ -7,28 +7,25 @@ R^2κ (faces, depth, limits) are in :mod:`ncd.figures.fig3_equilibrium.faces`, t
 positions of the equilibrium test in :mod:`ncd.figures.fig3_equilibrium.probes`.
 """
 import math
-from dataclasses import replace
 from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
-import yaml
 
-from ncd.figures.fig3_equilibrium import faces, probes
+from ncd.figures.fig3_equilibrium import faces
 from ncd.figures.fig3_equilibrium import measure as fe
 from ncd.shared.verdict import BEYOND, DIFFERS, REPRODUCED, judged, open_data, pct
 from ncd.solver.convergence import REST
-from ncd.solver.settings import SolverSettings
 
 F3 = ("fig3_equilibrium/ensemble.nc", "fig3_equilibrium/projection.nc", "fig3_equilibrium/uniform.nc")
 STATE = "fig3_equilibrium/state.nc"
+PROBES = "fig3_equilibrium/probes.nc"     # the one-step test on positions in and out of equilibrium
 WARM_FACTOR = 3        # "considerably accelerates": at least three times fewer sweeps
 COVER = 0.5            # an outline: the cloud's hull covers at least half of the exact polygon
 BAND = 0.1             # the vicinity of the boundary: the tenth of A ∩ C's volume nearest to it
 NOISE_SIGMAS = 3       # a fraction differs from another beyond 3 binomial standard deviations
 GHOST_MIN = 10         # ten dots on one edge (or at one vertex) draw a line (a point) in a cloud
 LIMIT_TOLS = 1e3       # limits closer than 10^3 solver tolerances (of the largest weight) are one
-FRICTION_MARGIN = 0.1  # friction a tenth above / below the least that holds the packing
 
 
 def _stamp(results, *rels):
@@ -66,32 +63,18 @@ def warm_accelerates_rest(results):
                   f"{WARM_FACTOR} times fewer)", "s2-warm-accelerates", F3[0])
 
 
-def _probe_rows(state):
-    """``[(position, expected equilibrium or None, [(init, u_f = 0, |u_f|, A ∩ C non-empty)])]``
-    for the packing, a lifted disc and the friction around the least that holds the packing."""
-    cfg = yaml.safe_load(state.attrs["config_yaml"])
-    settings = replace(SolverSettings(**cfg["solver"]), finish="active_set")
-    vtol, h = float(cfg["packing"]["velocity_tol"]), float(state.attrs["h"])
-    positions = [("the packing", probes.rebuild(state), True)]
-    disc, scene = probes.lifted(state)
-    if disc is not None:
-        positions.append((f"disc {disc} lifted by half its radius", scene, False))
-    mu_star = probes.least_friction(state)
-    if np.isfinite(mu_star) and mu_star > 0:
-        for f in (1 + FRICTION_MARGIN, 1 - FRICTION_MARGIN):
-            positions.append((f"μ = {f:g} μ*", probes.rebuild(state, mu=f * mu_star), None))
-    rows = [(name, expect, [(init, *probes.probe(sc, h, settings, init, vtol)) for init in ("zero", "warm")])
-            for name, sc, expect in positions]
-    return rows, mu_star, vtol
-
-
 def equilibrium_test(results):
-    """§2: one step from u_i = 0 decides equilibrium.  Rebuilt from state.nc: the packing (an
-    equilibrium), a disc lifted off its supports (it can only fall) and the packing with its
-    friction 10 % above and below μ*, the least coefficient for which A ∩ C is non-empty;
-    on each, the one-step test from the zero and the warm guess against the LP."""
-    state = open_data(results, STATE)
-    rows, mu_star, vtol = _probe_rows(state)
+    """§2: one step from u_i = 0 decides equilibrium.  Read from probes.nc (:mod:`.probes`,
+    written by its rule): the packing (an equilibrium), a disc lifted off its supports (it can
+    only fall) and the packing with its friction a tenth above and below μ*, the least
+    coefficient for which A ∩ C is non-empty; on each, the one-step test from the zero and the
+    warm guess against the LP."""
+    pr = open_data(results, PROBES)
+    mu_star, vtol = float(pr.attrs["mu_star"]), float(pr.attrs["velocity_tol"])
+    rows = [(str(name), int(pr.expected.values[k]) if pr.expected.values[k] >= 0 else None,
+             [(str(init), bool(pr.at_rest.values[k, j]), float(pr.max_velocity.values[k, j]),
+               bool(pr.admits_equilibrium.values[k, j])) for j, init in enumerate(pr.init.values)])
+            for k, name in enumerate(pr.position.values)]
     parts, agree, total = [], 0, 0
     for name, _, tests in rows:
         exact = tests[0][3]
@@ -111,10 +94,10 @@ def equilibrium_test(results):
                   + f" ({mu_txt}): the test agrees with the LP in {agree} of {total} steps",
                   REPRODUCED if ok else DIFFERS,
                   "on positions clearly in and out of equilibrium (the packing, a disc lifted off its supports, "
-                  f"friction {FRICTION_MARGIN:.0%} above and below the least μ* that holds the packing), the step from "
+                  f"friction {float(pr.attrs['friction_margin']):.0%} above and below the least μ* that holds the packing), the step from "
                   "the zero and the warm guess finds u_f = 0 exactly where the LP finds A ∩ C non-empty, and both "
                   "answers occur; the margin keeps away from μ*, where the step may also have a moving solution "
-                  "(Figure 1's two evolutions)", "s2-equilibrium-test", STATE)
+                  "(Figure 1's two evolutions)", "s2-equilibrium-test", PROBES)
 
 
 def _fig3_rows(results):

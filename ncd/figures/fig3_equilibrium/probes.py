@@ -7,8 +7,14 @@ whether ``A ∩ C`` is non-empty (one LP, :meth:`ncd.exact.polytope.ForcePolytop
 ``state.nc`` (:func:`rebuild`), the same packing with one disc lifted off its supports
 (:func:`lifted`: it can only fall) and the packing with its friction coefficient scaled
 around :func:`least_friction`, the smallest coefficient for which ``A ∩ C`` is non-empty.
+:func:`probe_dataset` runs them all; the rule ``fig3_equilibrium_probes`` writes it
+(``probes.nc``), so that the §2 claim reads data instead of stepping when a page renders.
 """
+from dataclasses import replace
+
 import numpy as np
+import xarray as xr
+import yaml
 
 from ncd.core.contacts import external_load, h_matrix
 from ncd.core.errors import InputError
@@ -16,6 +22,10 @@ from ncd.core.scene import make_scene
 from ncd.dynamics.stepper import equilibrium_test
 from ncd.exact.polytope import ForcePolytope, PolytopeError
 from ncd.figures.fig3_equilibrium.packing import rest_problem
+from ncd.solver.settings import SolverSettings
+
+FRICTION_MARGIN = 0.1   # the friction a tenth above and below the least that holds the packing
+INITS = ("zero", "warm")
 
 
 def rebuild(state, pos=None, mu=None):
@@ -93,3 +103,32 @@ def probe(scene, h, settings, init, velocity_tol):
     ``(u_f = 0, max |u_f| / (|g| h), A ∩ C non-empty)``."""
     eq = equilibrium_test(scene, h, settings, init=init, velocity_tol=velocity_tol)
     return bool(eq.at_rest), float(eq.max_velocity), admits_equilibrium(scene, eq.contacts)
+
+
+def probe_dataset(state):
+    """The one-step test against the LP on the packing of ``state``, a disc lifted off its
+    supports and the friction :data:`FRICTION_MARGIN` above and below the least that holds the
+    packing, each from the zero and the warm guess (NLGS then the exact active-set finish):
+    variables over ``(position, init)``; ``expected`` is 1 (an equilibrium), 0 (it can only
+    fall) or -1 (decided by the LP alone)."""
+    cfg = yaml.safe_load(state.attrs["config_yaml"])
+    settings = replace(SolverSettings(**cfg["solver"]), finish="active_set")
+    vtol, h = float(cfg["packing"]["velocity_tol"]), float(state.attrs["h"])
+    positions = [("the packing", rebuild(state), 1)]
+    disc, scene = lifted(state)
+    if disc is not None:
+        positions.append((f"disc {disc} lifted by half its radius", scene, 0))
+    mu_star = least_friction(state)
+    if np.isfinite(mu_star) and mu_star > 0:
+        for f in (1 + FRICTION_MARGIN, 1 - FRICTION_MARGIN):
+            positions.append((f"μ = {f:g} μ*", rebuild(state, mu=f * mu_star), -1))
+    found = np.array([[probe(sc, h, settings, init, vtol) for init in INITS] for _, sc, _ in positions], float)
+    dims = ("position", "init")
+    return xr.Dataset(
+        {"at_rest": (dims, found[..., 0].astype(np.int8), {"units": "1", "long_name": "one step from rest gives u_f = 0"}),
+         "max_velocity": (dims, found[..., 1], {"units": "1", "long_name": "largest |u_f| over |g| h"}),
+         "admits_equilibrium": (dims, found[..., 2].astype(np.int8), {"units": "1", "long_name": "A ∩ C non-empty (LP)"}),
+         "expected": ("position", np.array([e for *_, e in positions], np.int8),
+                      {"units": "1", "long_name": "an equilibrium (1), can only fall (0), decided by the LP alone (-1)"})},
+        coords={"position": [n for n, *_ in positions], "init": list(INITS)},
+        attrs={"mu_star": float(mu_star), "velocity_tol": vtol, "friction_margin": FRICTION_MARGIN})
