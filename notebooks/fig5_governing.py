@@ -124,10 +124,11 @@ for claim_id in gc.UNGER_CLAIMS:
 
 # %%
 verdicts = [gc.claim_unger_peak(results), gc.claim_unger_vanishes(results), gc.claim_unger_control(results)]
-Path(getattr(out, "caption", Path(inp.packings).with_name("caption.rst"))).write_text(
-    "**Beyond the paper: governing parameters of indeterminacy** (Unger, Kertész & Wolf's packings, their "
-    f"statistic η_U). {verdicts[0].value} ({verdicts[0].verdict}); {verdicts[1].value} ({verdicts[1].verdict}); "
-    f"{verdicts[2].value} ({verdicts[2].verdict}). Details: ``results/html/fig5_governing.html``.\n")
+with open(getattr(out, "caption", Path(inp.packings).with_name("caption.rst")), "w", encoding="utf-8") as caption:
+    caption.write(
+        "**Beyond the paper: governing parameters of indeterminacy** (Unger, Kertész & Wolf's packings, their "
+        f"statistic η_U). {verdicts[0].value} ({verdicts[0].verdict}); {verdicts[1].value} ({verdicts[1].verdict}); "
+        f"{verdicts[2].value} ({verdicts[2].verdict}). Details: ``results/html/fig5_governing.html``.\n")
 
 # %% [markdown]
 # <a id="unger-causes"></a>
