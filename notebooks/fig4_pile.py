@@ -102,6 +102,11 @@ write_finding(out, pp.finding(r))
 #    *Tolerance study* (`tolerance.nc`): the first members again (same review
 #    orders), plain NLGS without finishing, at tolerances from $10^{-3}$ to
 #    $10^{-6}$ (one sentence below).
+#    *Warm guess* (`warm.nc`): the same problem explored from the antecedent
+#    contact forces, the impulses of the construction's last step (the guess of
+#    its equilibrium test; `construction.nc` keeps that test's solution, so the
+#    rule replays the construction, checked bit for bit), with other random
+#    review orders and the same solver settings.
 # 5. *Beyond the paper*: the ground pressure profile (vertical ground force per
 #    unit length) under the pile, history and ensemble band, against the weight
 #    of the column of grains above each bin.
@@ -132,6 +137,9 @@ display(Markdown(pp.cloud_text(r) + "\n\n" + pp.tolerance_text(r, data["toleranc
 
 # %%
 display(Markdown(claim_markdown("s5-cloud", results, JUDGES)))
+
+# %%
+display(Markdown(claim_markdown("s5-warm-construction", results, JUDGES)))
 
 # %%
 display(Markdown(claim_markdown("s5-cloud-from-ignoring-antecedent", results, JUDGES)))

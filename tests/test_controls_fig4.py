@@ -32,12 +32,14 @@ def _ring(centre, radius, n=8):
 
 def write_pile(tmp_path, *, hist_angle=SURF, n_loaded=10, cloud_radius=0.05, cloud_shift=(0.0, 0.0),
                scan_step=0.5, tol_move=1e-4, ratio=None, dip=(0.5, 0.45, 0.55), dip_range=(0.2, 0.9),
-               angle_range=(SURF - 2, SURF + 2), fy_max=-0.1):
-    """cuts.nc, ensemble.nc, tolerance.nc and exact.nc of a pile in the variables the judging
-    functions read.  Defaults: every sentence holds (the history resultant parallel to the
+               angle_range=(SURF - 2, SURF + 2), fy_max=-0.1, warm_radius=None, warm_motion=0):
+    """cuts.nc, ensemble.nc, tolerance.nc, warm.nc and exact.nc of a pile in the variables the
+    judging functions read.  Defaults: every sentence holds (the history resultant parallel to the
     surface and inside a small cloud far wider than the tolerance's effect, scan cuts one
     diameter apart changing by ``scan_step``, a central ground deficit, a forced dip, every
-    admissible state arching within 2° of the surface)."""
+    admissible state arching within 2° of the surface, warm-guess runs at rest (at 1e-7 g h, as
+    NLGS leaves them) in a cloud ``warm_radius`` = 1 % of the zero-guess one, ``warm_motion``
+    of them converged with a grain moving at g h)."""
     d = 1.0
     scan = np.arange(1, 7, dtype=float)
     kind = np.array(["default", "minus", "plus"] + ["scan"] * 12)
@@ -69,8 +71,17 @@ def write_pile(tmp_path, *, hist_angle=SURF, n_loaded=10, cloud_radius=0.05, clo
     fx[:-1, 0], fy[:-1, 0] = cloud[:, 0], cloud[:, 1]
     fx[-1, 0], fy[-1, 0] = 50.0, 50.0
     ens = xr.Dataset({"outcome": ("run", np.r_[np.ones(runs - 1), 2].astype(np.int8)),
+                      "max_speed": ("run", np.r_[np.full(runs - 1, 1e-12), 1.0]),
                       "cut_force_x": (("run", "cut"), fx), "cut_force_y": (("run", "cut"), fy),
                       "ground_pressure": (("run", "bin"), np.tile(p, (runs, 1)))}, coords={"tol": 1e-5})
+    # warm-guess runs: every cut's resultant on a ring around the history one
+    wr = 0.01 * cloud_radius if warm_radius is None else warm_radius
+    ring = _ring(np.zeros(2), 1.0, 16)
+    wfx, wfy = H[:, 0][None] + wr * ring[:, :1], H[:, 1][None] + wr * ring[:, 1:]
+    speed = np.r_[np.full(16 - warm_motion, 1e-7), np.ones(warm_motion)]
+    warm = xr.Dataset({"outcome": ("run", np.where(speed > 1e-8, 2, 1).astype(np.int8)), "max_speed": ("run", speed),
+                       "cut_force_x": (("run", "cut"), wfx), "cut_force_y": (("run", "cut"), wfy)},
+                      coords={"tol": 1e-5}, attrs={"rest_speed_tol": 1e-6, "guess_offset": 2.6e-6})
     tols = np.array([1e-4, 1e-5, 1e-6])
     tfx = np.repeat(fx[:3, None, :], 3, axis=1)
     tfx[:, :, 0] += tol_move * np.arange(3)[None, :]        # each tolerance step moves a resultant by tol_move
@@ -92,7 +103,7 @@ def write_pile(tmp_path, *, hist_angle=SURF, n_loaded=10, cloud_radius=0.05, clo
                      "dip_min": ("choice", np.full(3, dip_range[0])), "dip_max": ("choice", np.full(3, dip_range[1]))},
                     attrs={"dip_main_choice": "kernel 2 d"})
     (tmp_path / "fig4_pile").mkdir(exist_ok=True)
-    for name, ds in (("cuts", cuts), ("ensemble", ens), ("tolerance", tol), ("exact", ex)):
+    for name, ds in (("cuts", cuts), ("ensemble", ens), ("tolerance", tol), ("exact", ex), ("warm", warm)):
         ds.to_netcdf(tmp_path / "fig4_pile" / f"{name}.nc")
     return tmp_path
 
@@ -125,6 +136,22 @@ def test_cloud_from_ignoring_antecedent_controls(tmp_path):
     assert pile.fig4_cloud_vs_history(write_pile(tmp_path, cloud_shift=(0.12, 0.0))).verdict == REPRODUCED
     v = pile.fig4_cloud_vs_history(write_pile(tmp_path, cloud_shift=(0.5, 0.0)))   # 5 diameters away
     assert v.verdict == DIFFERS and "outside the cloud's hull" in v.value
+
+
+def test_warm_construction_controls(tmp_path):
+    """§5's warm start: the warm-guess cloud an order of magnitude below the zero-guess one."""
+    v = pile.fig4_warm_construction(write_pile(tmp_path))            # 100 times narrower
+    assert v.verdict == REPRODUCED and "16 of 16 warm-guess runs at rest" in v.value and "0.01 times" in v.value
+    # the runs NLGS leaves at 1e-7 g h count as at rest (the equilibrium test's 1e-6), as the history state
+    assert "converged in another state" not in v.value
+    # the warm guess as indeterminate as the zero guess: as wide a cloud
+    v = pile.fig4_warm_construction(write_pile(tmp_path, warm_radius=0.05))
+    assert v.verdict == DIFFERS and "(1 times)" in v.value
+    # five times narrower only: not an order of magnitude
+    assert pile.fig4_warm_construction(write_pile(tmp_path, warm_radius=0.01)).verdict == DIFFERS
+    # a narrow cloud, but some warm runs end with a grain falling: another outcome, not "no indeterminacy"
+    v = pile.fig4_warm_construction(write_pile(tmp_path, warm_motion=3))
+    assert v.verdict == DIFFERS and "13 of 16" in v.value and "3 converged in another state" in v.value
 
 
 def test_cut_position_controls(tmp_path):

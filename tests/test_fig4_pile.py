@@ -231,6 +231,38 @@ def test_tolerance_study_copies_only_what_a_fresh_run_repeats(data):
         np.testing.assert_array_equal(fresh[k].isel(tol=0).values, tol[k].sel(tol=last, run=members).values)
 
 
+@pytest.fixture(scope="module")
+def warm(results):
+    return xr.load_dataset(results / "fig4_pile" / "warm.nc")
+
+
+def test_warm_runs_start_from_the_antecedent_forces(data, warm):
+    """warm.nc explores the ensemble's problem with its solver settings and cuts, from the
+    construction's last impulses (matched on the contacts of the final state, close to the history
+    forces: the pile was at rest), with the review orders of another root seed."""
+    ens = data["ensemble"]
+    assert warm.attrs["init"] == "warm" and ens.attrs["init"] == "zero"
+    assert warm.attrs["root_seed"] != ens.attrs["root_seed"]
+    for k in ("max_sweeps", "check_every", "moving_tol", "finish", "finish_tol", "h", "weight"):
+        np.testing.assert_equal(warm.attrs[k], ens.attrs[k], err_msg=k)
+    assert float(warm.tol) == float(ens.tol)
+    np.testing.assert_array_equal(warm.cut.values, ens.cut.values)
+    assert warm.attrs["guess_matched"] >= 0.95 * data["construction"].sizes["contact"]
+    assert warm.attrs["guess_offset"] < 1e-3
+    assert warm.converged.values.all()
+
+
+def test_warm_members_do_not_depend_on_the_shard(data, warm):
+    """The last warm member, re-run alone (the construction replayed again), gives the same bits."""
+    cfg = yaml.safe_load(warm.attrs["config_yaml"])
+    guess = pile.antecedent(cfg, data["construction"])
+    last = int(warm.run.values[-1])
+    again = pile.ensemble_shard(cfg, data["construction"], data["cuts"], [last], [float(warm.tol)],
+                                int(warm.attrs["root_seed"]), finish=warm.attrs["finish"], guess=guess)
+    for k in ("cut_force_x", "cut_force_y", "ground_pressure", "sweeps", "residual", "outcome", "max_speed"):
+        np.testing.assert_array_equal(again[k].isel(tol=0).values[0], warm[k].sel(run=last).values)
+
+
 def test_default_cut_resultant_is_parallel_to_the_surface(data):
     cuts, ens = data["cuts"], data["ensemble"]
     k = int(np.nonzero(cuts.kind.values == "default")[0][0])

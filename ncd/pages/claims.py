@@ -41,8 +41,6 @@ CLAIM_BY_ID = {c["id"]: c for c in CLAIMS}
 UNTESTED_REASONS = {
     "s2-md-forces-state": "the MD baseline (ncd/dynamics/md.py) is used for stability only; no exploration of "
                           "the plurality of its force states is run",
-    "s5-warm-construction": "the final step of a warm-started construction is not explored with random orders "
-                            "from the warm guess (the zero-guess cloud is)",
     "s5-cylindric-cuts": "a 3-D statement (cylindric cuts of a conical pile); the 2-D analogue is the vertical "
                          "cut of §5, and the end of the fig4_bank page says what a plane pile can say of it",
     "s6-incremental-coulomb": "a statement about theory (an incremental Coulomb law), not about a computation",

@@ -6,7 +6,10 @@
 #              ranges, ground-pressure bands, dip verdict   -> exact.nc
 #   explore    zero-guess NLGS runs (random orders) of one shard of
 #              the ensemble or of the tolerance study               -> shards/<name>_<k>-of-<n>.nc
-#   merge      the shards, in member order                          -> ensemble.nc, tolerance.nc
+#   warm       the same problem from the construction's last impulses (replayed: construction.nc
+#              keeps the history forces, not that guess), other random orders
+#                                                                   -> shards/warm_<k>-of-<n>.nc
+#   merge      the shards, in member order                          -> ensemble.nc, tolerance.nc, warm.nc
 #   notebook   notebooks/fig4_pile.ipynb (figure and sentences: ncd/figures/fig4_pile/plots.py)
 #                                                                   -> results/figures/fig4_pile.png|pdf
 FIG4 = "fig4_pile"
@@ -18,7 +21,11 @@ CFG4_SIM = {k: CFG4[k] for k in ("seed", "grains", "ground", "mu", "mu_ground", 
 CFG4_CUTS = {**CFG4_SIM, **{k: CFG4[k] for k in ("surface", "cut", "pressure")}}
 CFG4_EXACT = {**CFG4_CUTS, "exact": CFG4["exact"]}
 CFG4_EXP = {**CFG4_CUTS, **{k: CFG4[k] for k in ("ensemble", "tolerance_study")}}
-F4_SHARDS = {"ensemble": CFG4["ensemble"]["shards"], "tolerance": CFG4["tolerance_study"]["shards"]}
+# the warm runs: the pile's sections and the ensemble's solver settings (not its members)
+CFG4_WARM = {**CFG4_CUTS, "warm_ensemble": CFG4["warm_ensemble"],
+             "ensemble": {k: v for k, v in CFG4["ensemble"].items() if k not in ("runs", "shards", "root_seed")}}
+F4_SHARDS = {"ensemble": CFG4["ensemble"]["shards"], "tolerance": CFG4["tolerance_study"]["shards"],
+             "warm": CFG4["warm_ensemble"]["shards"]}
 
 
 rule fig4_pile_simulate:
@@ -103,6 +110,30 @@ rule fig4_pile_explore:
         "../scripts/fig4_pile_explore.py"
 
 
+rule fig4_pile_warm:
+    priority: PRIORITY["fig4_pile"]
+    input:
+        construction=f"{F4}/construction.nc",
+        cuts=f"{F4}/cuts.nc",
+        code=code_of("fig4_pile_warm"),
+    output:
+        temp(f"{F4}/shards/warm_{{shard}}-of-{{n}}.nc"),
+    wildcard_constraints:
+        shard=r"\d+",
+        n=r"\d+",
+    threads: ENSEMBLE_THREADS
+    params:
+        config=without_shards(CFG4_WARM),
+    log:
+        log(FIG4, "warm_{shard}-of-{n}"),
+    benchmark:
+        bench(FIG4, "warm_{shard}-of-{n}")
+    conda:
+        CONDA_ENV
+    script:
+        "../scripts/fig4_pile_warm.py"
+
+
 rule fig4_pile_merge:
     priority: PRIORITY["fig4_pile"]
     input:
@@ -111,7 +142,7 @@ rule fig4_pile_merge:
     output:
         f"{F4}/{{name}}.nc",
     wildcard_constraints:
-        name="ensemble|tolerance",
+        name="ensemble|tolerance|warm",
     params:
         dim="run",
     log:
@@ -131,6 +162,7 @@ rule fig4_pile_notebook:
         cuts=f"{F4}/cuts.nc",
         ensemble=f"{F4}/ensemble.nc",
         tolerance=f"{F4}/tolerance.nc",
+        warm=f"{F4}/warm.nc",
         exact=f"{F4}/exact.nc",
         notebook=notebook_file(FIG4),
         notebook_py=notebook_file(FIG4, "py"),

@@ -5,17 +5,21 @@ equilibrium test of section 2 passes).  Its final arrangement is then explored b
 runs from the zero guess with random review orders (section 5), keeping per run the
 measures of :mod:`ncd.shared.cuts` (cut resultants, ground pressure) and the run's
 outcome (:func:`ncd.solver.convergence.classify`: converged at rest, in motion, or not).
+The warm-guess ensemble explores the same problem from the construction's last impulses
+(:func:`antecedent`), with other random orders: the "antecedent contact forces" of section 5.
 """
 
 import numpy as np
 import scipy.sparse as sp
 import xarray as xr
 
+from ncd.core.contacts import match_warm
+from ncd.core.errors import SimulationError
 from ncd.dynamics.explore import explore
 from ncd.io.netcdf import provenance
 from ncd.io.progress import Progress
 from ncd.shared import cuts as cm
-from ncd.shared.pile import cut_specs, equilibrium_problem, final_scene, free_surface
+from ncd.shared.pile import construct, cut_specs, equilibrium_problem, final_scene, free_surface
 from ncd.shared.sources import mean_diameter
 from ncd.solver.convergence import MAX_SPEED_ATTRS, outcome_attrs
 from ncd.solver.settings import SolverSettings
@@ -100,18 +104,51 @@ def _observable(cfg, scene, contacts, C, edges):
     return observe
 
 
-def ensemble_shard(cfg, construction, cuts, members, tolerances, root_seed, log=None, finish=None):
+def antecedent(cfg, construction, log=None):
+    """``(keys, impulse)``: the impulses of the construction's last step, the warm guess its
+    final equilibrium test started from (the "antecedent contact forces" of section 5).
+
+    construction.nc keeps that test's solution (the history forces), not its guess, so the
+    construction is replayed (:func:`ncd.shared.pile.construct`, deterministic) and checked
+    against construction.nc bit for bit (positions, contacts, history forces)."""
+    scene, _, _, eq = construct(cfg, log)
+    nm, ds = scene.n_mobile, construction
+    same = (nm == ds.sizes["grain"] and np.array_equal(scene.pos[:nm, 0], ds["x"].values)
+            and np.array_equal(scene.pos[:nm, 1], ds["y"].values)
+            and np.array_equal(eq.contacts.key, ds["key"].values)
+            and np.array_equal(eq.forces[:, 0], ds["force_n"].values)
+            and np.array_equal(eq.forces[:, 1], ds["force_t"].values))
+    if not same:
+        raise SimulationError("the replayed construction differs from construction.nc: its last impulses "
+                              "cannot stand for the antecedent forces of the stored pile")
+    return np.asarray(scene.prev_keys, np.int64).copy(), np.asarray(scene.prev_impulse, float).copy()
+
+
+def ensemble_shard(cfg, construction, cuts, members, tolerances, root_seed, log=None, finish=None, guess=None):
     """NLGS runs from the zero guess with random orders on the final state (section 5), one
     set per tolerance: cut resultants, ground force, velocity summary and solver record per run.
 
     ``finish="active_set"`` hands each run over at ``tol`` to :mod:`ncd.solver.finish`, an
     exact solution whose observable needs no tracking; ``"none"``: plain NLGS, converged
-    only when the observable has settled too."""
+    only when the observable has settled too.  ``guess``: ``(keys, impulse)`` of a warm guess
+    matched by body pair (:func:`antecedent`); None: the zero guess."""
     e = cfg["ensemble"]
     h, g = cfg["h"], cfg["gravity"]
     scene = final_scene(cfg, construction)
     problem = equilibrium_problem(cfg, scene, construction)
     c, nm = problem.contacts, scene.n_mobile
+    init, warm_attrs = "zero", {}
+    if guess is not None:
+        init = "warm"
+        scene.prev_keys, scene.prev_impulse = np.asarray(guess[0], np.int64), np.asarray(guess[1], float)
+        s0 = match_warm(c, scene.prev_keys, scene.prev_impulse)
+        hist = h * np.column_stack([construction["force_n"].values, construction["force_t"].values])
+        warm_attrs = dict(guess_matched=int(np.count_nonzero(np.any(s0 != 0, axis=1))),
+                          guess_offset=float(np.abs(s0 - hist).sum() / max(np.abs(hist).sum(), 1e-300)),
+                          rest_speed_tol=float(cfg["construction"]["velocity_tol"]),
+                          guess_note="the impulses of the construction's last step (the warm guess of its equilibrium "
+                                     "test), matched by body pair; guess_offset: their relative L1 distance to h times "
+                                     "the history forces; rest_speed_tol: the equilibrium test's at-rest speed (g h)")
     C, _ = cm.cut_matrix(c, scene.pos, nm, cut_specs(cuts))
     edges = np.append(cuts["bin_lo"].values, cuts["bin_hi"].values[-1])
     G = cm.ground_matrix(c, nm, edges)
@@ -141,7 +178,8 @@ def ensemble_shard(cfg, construction, cuts, members, tolerances, root_seed, log=
         if len(rows) == 0:
             continue
         prog = Progress(log, len(rows), f"tol {tol:g}") if log is not None else None
-        out = explore(scene, problem, members[rows], root_seed, settings=settings, progress=prog, observe=observe)
+        out = explore(scene, problem, members[rows], root_seed, init=init, settings=settings, progress=prog,
+                      observe=observe)
         s = out["impulse"].reshape(len(rows), -1)
         F = (C @ s.T).T / h
         res["cut_force_x"][rows, j], res["cut_force_y"][rows, j] = F[:, 0::2], F[:, 1::2]
@@ -170,8 +208,9 @@ def ensemble_shard(cfg, construction, cuts, members, tolerances, root_seed, log=
                                   "cut": cuts["cut"].values, "bin": cuts["bin"].values},
                     attrs=provenance(cfg, root_seed=root_seed, h=h, weight=construction.attrs["weight"],
                                      max_sweeps=e["max_sweeps"], check_every=e["check_every"],
-                                     moving_tol=e["moving_tol"], init="zero", review="random", finish=finish,
-                                     finish_tol=e.get("finish_tol", 1e-10) if finish != "none" else np.nan))
+                                     moving_tol=e["moving_tol"], init=init, review="random", finish=finish,
+                                     finish_tol=e.get("finish_tol", 1e-10) if finish != "none" else np.nan,
+                                     **warm_attrs))
     ds["max_velocity"].attrs["units"] = "g h (largest |u_f| or |r w_f| over grains; 0 at equilibrium)"
     ds["outcome"].attrs.update(outcome_attrs())
     ds["max_speed"].attrs.update(MAX_SPEED_ATTRS)
