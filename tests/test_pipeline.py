@@ -256,7 +256,7 @@ def test_a_code_stamp_holds_the_hash_of_each_source_of_its_set(dag_repo):
 
 @pytest.mark.parametrize("module, rules", [
     ("pages/report.py", {"index"}),
-    ("pages/render.py", {"render_html", "index"}),
+    ("pages/render.py", {"render_html", "index", "html_mathjax"}),   # the MathJax copy is render.py's too
     ("pages/notebook.py", None),           # every notebook rule, render_html, index
 ])
 def test_editing_a_page_module_reruns_only_page_rules(dag_repo, module, rules):
