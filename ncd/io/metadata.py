@@ -24,7 +24,6 @@ KNOWN = {
     "frame": ("1", "stored frame index"), "key": ("1", "contact key (body pair code)"),
     "prev_key": ("1", "contact key at the previous step"), "body_a": ("1", "first body of the contact"),
     "body_b": ("1", "second body of the contact (walls after the discs)"),
-    "position": ("1", "position on which the one-step equilibrium test runs"),
     "case": ("1", "stability case"), "method": ("1", "integration method"), "kind": ("1", "kind"),
     "init": ("1", "initial guess of NLGS (zero, random or warm)"), "criterion": ("1", "NLGS stopping criterion"),
     "state": ("1", "state on which NLGS runs"), "evolution": ("1", "evolution (first-guess policy)"),

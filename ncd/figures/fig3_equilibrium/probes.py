@@ -130,5 +130,7 @@ def probe_dataset(state):
          "admits_equilibrium": (dims, found[..., 2].astype(np.int8), {"units": "1", "long_name": "A ∩ C non-empty (LP)"}),
          "expected": ("position", np.array([e for *_, e in positions], np.int8),
                       {"units": "1", "long_name": "an equilibrium (1), can only fall (0), decided by the LP alone (-1)"})},
-        coords={"position": [n for n, *_ in positions], "init": list(INITS)},
+        coords={"position": ("position", [n for n, *_ in positions],
+                             {"units": "1", "long_name": "position on which the one-step equilibrium test runs"}),
+                "init": list(INITS)},
         attrs={"mu_star": float(mu_star), "velocity_tol": vtol, "friction_margin": FRICTION_MARGIN})
