@@ -15,37 +15,45 @@
 # ---
 
 # %% [markdown]
-# # Beyond the paper (section 5): history as statistics — piles from a point source and from a rain
+# # Beyond the paper (section 5): history as statistics — a point source against a rain, at matched shape
 #
 # **What the paper says (section 5).** Measurements on sand piles poured from a
 # localized source show a ground-pressure minimum under the apex; the messages from
 # history (the construction) shape the forces. The literature ties the dip to the
-# construction history: Vanel et al., *Memory in sandpiles*, PRE 60, R5040 (1999),
-# find a dip under piles poured from a localized source and a maximum under piles
-# built by raining sand through a sieve over the base; Geng, Longhi, Behringer and
-# Howell, PRE 64, 060301 (2001), find the same contrast in 2-D piles of photoelastic
-# discs (a small dip for a point source, a hump for a rain).
+# construction history: Vanel et al., *Memories in sand*, PRE 60, R5040 (1999),
+# find a dip under heaps poured from a localized source and none under heaps of the
+# same shape built by raining sand through a sieve; Geng, Longhi, Behringer and
+# Howell, PRE 64, 060301 (2001), find the same contrast in 2-D heaps of photoelastic
+# discs. To attribute a difference to history, the heaps compared must have the same
+# shape: this page states the shape match first, then the differences at that shape.
 #
-# **What we compute.** For each member $m$ of the ensemble, two piles of the *same*
+# **What we compute.** For each member $m$ of the ensemble, three piles of the *same*
 # grains (same radii, inserted in the same order) on the *same* rough ground:
 #
 # 1. *point source*: Figure 4's construction (insertion sites above $x = 0$, a drop
 #    height that rises with the pile), with up to three grains stacked per site at
 #    each attempt (same speed);
-# 2. *rain*: the grains dropped at positions uniform over $|x| \le L$, $L$ the base
-#    half-width of the member's point-source pile, from a height that rises with the
-#    deposit, onto a **finite base**: the member's ground discs with $|x| \le L$, as in
-#    the experiments (sand rained through a sieve onto a base of finite size). Grains
-#    that roll off the base edges are removed from the simulation once they have
-#    fallen below the base, and counted.
+# 2. *rain*: grains dropped at positions uniform under a sieve that follows the
+#    growing heap (it spans the footprint of the settled grains, a few outliers left
+#    out, and never narrows), from a height that rises with the heap: the grains land
+#    on the heap, which grows at its angle of repose as the point source's does;
+# 3. *layer*: grains dropped uniformly over $|x| \le L$ ($L$ the base half-width of
+#    the member's point-source pile) from the first grain on, onto a **finite base**
+#    (the member's ground discs with $|x| \le L$); grains that roll off its edges are
+#    removed and counted. It deposits a flat-topped layer, not a heap: the shape that
+#    differs, kept as the known difference the comparison must detect.
 #
 # Every pile is stepped until the warm equilibrium test of section 2 passes; its
-# forces are the history forces. Per pile: the ground stress profile (Gaussian kernel
-# average of the ground-contact forces against $x / L$, $L$ the base half-width of the
-# member's point-source pile from its flank fits, in units of the mean stress $W / 2L$), the dip depth
+# forces are the history forces. Per pile: the shape (flank slope, apex height, base
+# half-width), the ground stress profile (Gaussian kernel average of the ground-contact
+# forces against $x / L$, $L$ the pile's own base half-width from its flank fits, the
+# layer's that of its base, in units of the mean stress $W / 2L$), the dip depth
 # $M - m$ in the same unit (the neighbouring maxima $M$ minus the central minimum $m$:
-# $> 0$ a dip, $< 0$ a hump; the dip depth of `fig4_pile` has the same unit and sign), and the resultant across vertical cuts along both flanks with its angle to
-# the pile's own free surface. Bands are bootstrap resamples of the **piles**.
+# $> 0$ a dip, $< 0$ a hump; the dip depth of `fig4_pile` has the same unit and sign),
+# and the resultant across vertical cuts along both flanks with its angle to the pile's
+# own free surface. Bands are bootstrap resamples of the **piles**; differences between
+# histories are permutation tests of the history labels over piles, checked on two
+# controls (two halves of one history must not differ; the layer must differ from the heap).
 
 # %%
 from pathlib import Path
@@ -69,28 +77,34 @@ except NameError:  # by hand, from the repository root after `snakemake -j2 fig4
     n = cfg["grains"]["n"]
     inp = SimpleNamespace(analysis=f"results/fig4_history/analysis_n{n}.nc",
                           point=f"results/fig4_history/piles/n{n}/point_000.nc",
-                          rain=f"results/fig4_history/piles/n{n}/rain_000.nc")
+                          rain=f"results/fig4_history/piles/n{n}/rain_000.nc",
+                          layer=f"results/fig4_history/piles/n{n}/layer_000.nc")
     out = SimpleNamespace(png="results/figures/fig4_history.png", pdf="results/figures/fig4_history.pdf",
                           finding="results/figures/fig4_history.finding.rst")
 an = xr.load_dataset(inp.analysis)
 results = Path(inp.analysis).resolve().parents[1]
-piles = [xr.load_dataset(inp.point), xr.load_dataset(inp.rain)]
+piles = [xr.load_dataset(inp.point), xr.load_dataset(inp.rain), xr.load_dataset(inp.layer)]
 
 # %%
 save(hp.figure(an, piles), out, dpi=130, show=True)
 write_finding(out, hp.finding(an))
 
 # %% [markdown]
-# **(a)** Member 0 of each history (the same grains). **(b)** Mean ground stress over
-# the piles with its 95 % bootstrap band over piles. **(c)** Dip depth of every pile
-# (dots) and of the mean profile with its basic bootstrap band (bars), for three kernel
-# widths; $p$ is the permutation test of the difference between the histories.
-# **(d)** Angle of the cut resultant minus the flank slope, median over piles (bars:
-# bootstrap band of the median; shade: 25–75 % of the piles; thin lines: the exact
-# range over $A \cap C$ of single piles).
+# **(a)** Member 0 of each history (the same grains). **(b)** The shape match: relative
+# difference of the mean piles from the point source's, with its bootstrap band over
+# piles, against the tolerance (grey strip); the same for two halves of the point piles.
+# **(c)** Mean ground stress over the piles with its 95 % bootstrap band over piles.
+# **(d)** Dip depth of every pile (dots) and of the mean profile with its basic bootstrap
+# band (bars), for three kernel widths; $p$ is the permutation test of the difference
+# between point source and rain. **(e)** Angle of the cut resultant minus the flank
+# slope, median over piles (bars: bootstrap band of the median; shade: 25–75 % of the
+# piles; thin lines: the exact range over $A \cap C$ of single piles).
 
 # %%
 display(Markdown(hp.shapes_text(an, cfg)))
+
+# %%
+display(Markdown(hp.comparison_text(an)))
 
 # %%
 display(Markdown(hp.stress_text(an)))

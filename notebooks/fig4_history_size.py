@@ -67,7 +67,7 @@ write_finding(out, hs.finding(sz))
 # %%
 g, piles = s["grains"], s["piles"]
 rows = []
-for h in ("point", "rain"):
+for h in sz.history.values:
     r = s[h]
     rows.append(f"| {h} | " + " | ".join(
         f"{r['dip_mean'][i]:.3f} [{r['dip_lo'][i]:.3f}, {r['dip_hi'][i]:.3f}]" for i in range(len(g))) + " | "
@@ -108,6 +108,8 @@ half-widths of {P['half_width'][0]:.0f} d and {P['half_width'][-1]:.0f} d (cone 
 {P['cone_ratio'][0]:.2f} and {P['cone_ratio'][-1]:.2f}). The rain deposits have flanks of
 {R['surface_angle'][0]:.1f}° and {R['surface_angle'][-1]:.1f}° and cone ratios {R['cone_ratio'][0]:.2f} and
 {R['cone_ratio'][-1]:.2f} (1: a cone; below: flat-topped).
+
+**Shape match.** {hs.shape_text(sz)}
 
 **Limits.** The large size has only {piles[-1]} piles per history: its bands are wide, and a change smaller than them is not resolved. A claim about
 size rests on these bands, not on one pile.

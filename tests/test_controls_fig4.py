@@ -218,32 +218,47 @@ def test_geometry_enough_and_reassuring_judged_on_the_admissible_set(tmp_path):
 
 
 # ------------------------------------------------------------------ fig4_history: synthetic analysis
-def write_history(tmp_path, profile, deviation, piles=8, seed=0):
-    """analysis_n1000.nc of point and rain piles: the per-pile ground-stress profile ``profile(xi,
-    rng)``, the cut deviations ``deviation(rng, shape)``; the dip bands are computed as in
-    :func:`ncd.figures.fig4_history.analysis.ensemble_dataset`."""
+def write_history(tmp_path, profile, deviation, piles=8, seed=0, rain=None, shapes=None):
+    """analysis_n1000.nc of point, rain and layer piles: the per-pile ground-stress profile
+    ``profile(xi, rng)`` (the rain's ``rain``, default the same), the cut deviations
+    ``deviation(rng, shape)``, the mean shapes ``shapes = {history: (flank slope, apex d, half-width d)}``
+    (default: rain as the point source, the layer flat); the dip bands are computed as in
+    :func:`ncd.figures.fig4_history.analysis.ensemble_dataset` and the comparisons by its
+    :func:`ncd.figures.fig4_history.analysis.comparisons`."""
+    from ncd.figures.fig4_history.analysis import comparisons
     rng = np.random.default_rng(seed)
     xi = np.linspace(-1.3, 1.3, 261)
     q = np.linspace(0.1, 0.9, 9)
     kernels = np.array([2.0, 1.0, 4.0])
-    prof = np.array([[[profile(xi, rng) for _ in kernels] for _ in range(piles)] for _ in range(2)])
+    hist = ["point", "rain", "layer"]
+    flat = lambda x, r: 1.0 * (np.abs(x) <= 1) + 0.03 * r.standard_normal(x.size)  # noqa: E731
+    fns = {"point": profile, "rain": rain or profile, "layer": flat}
+    prof = np.array([[[fns[h](xi, rng) for _ in kernels] for _ in range(piles)] for h in hist])
     center, flank = 0.1, (0.25, 0.7)
     dips = dip_depth(prof, xi, center, flank)
     idx = bootstrap_index(rng, piles, 500)
     boot = dip_depth(prof[:, idx].mean(axis=2), xi, center, flank)
     mean = dip_depth(prof.mean(axis=1), xi, center, flank)
     lo, hi = basic_band(mean, boot, 0.025, 0.975, axis=1)
-    dev = deviation(rng, (2, piles, 2, len(q)))
+    dev = deviation(rng, (3, piles, 2, len(q)))
     boot_med = np.nanmedian(dev[:, idx], axis=2)
-    H, P, K, F, Q = "history", "pile", "kernel", "flank", "cut_position"
+    shapes = {"point": (SURF, 17.0, 58.0), "rain": (SURF, 17.0, 58.0), "layer": (4.0, 9.5, 128.0), **(shapes or {})}
+    noise = np.array([1.0, 0.6, 1.8])
+    sh = np.array([[np.array(shapes[h]) + noise * rng.standard_normal(3) for _ in range(piles)] for h in hist])
+    d = 0.002
+    H, P, K, F, Q, X = "history", "pile", "kernel", "flank", "cut_position", "xi"
     an = xr.Dataset(
         {"dip": ((H, P, K), dips), "dip_mean": ((H, K), mean), "dip_lo": ((H, K), lo), "dip_hi": ((H, K), hi),
-         "dip_diff_p": ((K,), np.full(3, 0.5)), "cut_deviation": ((H, P, F, Q), dev),
-         "surface_angle": ((H, P, F), np.full((2, piles, 2), SURF)),
+         "profile": ((H, P, K, X), prof), "cut_deviation": ((H, P, F, Q), dev),
+         "surface_angle": ((H, P, F), np.repeat(sh[..., :1], 2, axis=2)),
+         "apex_height": ((H, P), sh[..., 1]), "fit_half_width": ((H, P), sh[..., 2] * d),
          "deviation_median_lo": ((H, F, Q), np.quantile(boot_med, 0.025, axis=1)),
          "deviation_median_hi": ((H, F, Q), np.quantile(boot_med, 0.975, axis=1))},
-        coords={H: ["point", "rain"], P: np.arange(piles), K: kernels, F: ["left", "right"], Q: q},
-        attrs={"level": 0.95})
+        coords={H: hist, P: np.arange(piles), K: kernels, F: ["left", "right"], Q: q, X: xi},
+        attrs={"level": 0.95, "mean_diameter": d})
+    cfg = {"analysis": {"dip_center": center, "dip_flank": list(flank), "permutations": 300, "bootstrap": 300,
+                        "level": 0.95}}
+    an = comparisons(cfg, an, hist, rng)
     (tmp_path / "fig4_history").mkdir(exist_ok=True)
     an.to_netcdf(tmp_path / "fig4_history" / "analysis_n1000.nc")
     return tmp_path
@@ -266,6 +281,29 @@ def test_history_dip_controls(tmp_path):
     v = hist.fig4_history_dip(write_history(tmp_path, _dipped, _parallel))
     assert v.verdict == REPRODUCED
     assert hist.fig4_history_dip(write_history(tmp_path, _humped, _parallel)).verdict == DIFFERS
+
+
+def test_history_dip_contrast_controls(tmp_path):
+    """Vanel et al.'s contrast at matched shape: a dipped point source against a humped rain
+    reproduces; the same dip under both differs; unmatched shapes, or a layer that the test
+    cannot tell from the heap (its positive control failing), are not tested."""
+    v = hist.history_dip_contrast(write_history(tmp_path, _dipped, _parallel, piles=16, rain=_humped))
+    assert v.verdict == REPRODUCED, v.value
+    assert "matched within 5 %" in v.value and "controls: " in v.value
+    same = write_history(tmp_path, _dipped, _parallel, piles=16)
+    assert hist.history_dip_contrast(same).verdict == DIFFERS
+    steep = write_history(tmp_path, _dipped, _parallel, piles=16, rain=_humped, shapes={"rain": (SURF * 0.8, 17.0, 58.0)})
+    assert hist.history_dip_contrast(steep).verdict == NOT_TESTED
+    blind = write_history(tmp_path, _dipped, _parallel, piles=16, rain=_humped,
+                          shapes={"layer": (SURF, 17.0, 58.0)})
+    an = xr.load_dataset(blind / "fig4_history" / "analysis_n1000.nc")
+    an["profile"].loc[{"history": "layer"}] = an.profile.sel(history="point").values
+    from ncd.figures.fig4_history.analysis import comparisons
+    an = comparisons({"analysis": {"dip_center": 0.1, "dip_flank": [0.25, 0.7], "permutations": 300,
+                                   "bootstrap": 300, "level": 0.95}},
+                     an.drop_dims(["comparison", "shape"]), ["point", "rain", "layer"], np.random.default_rng(1))
+    an.to_netcdf(blind / "fig4_history" / "analysis_n1000.nc")
+    assert hist.history_dip_contrast(blind).verdict == NOT_TESTED
 
 
 def test_history_arching_judged_on_the_band_of_the_median(tmp_path):

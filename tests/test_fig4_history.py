@@ -117,7 +117,7 @@ def test_pile_file_exports_its_frames(uninterrupted, tmp_path):
     assert len(meshio.read(ground_file).points) == ds.sizes["ground"]
 
 
-def test_rain_source_and_same_grains():
+def test_layer_source_and_same_grains():
     cfg = small_cfg(30)
     r1, r2 = history.grain_radii(cfg, 5), history.grain_radii(cfg, 5)
     assert np.array_equal(r1, r2) and not np.array_equal(r1, history.grain_radii(cfg, 6))
@@ -126,9 +126,65 @@ def test_rain_source_and_same_grains():
     assert len(r) > 5 and np.all(np.abs(p[:, 0]) <= 0.01)
     assert np.array_equal(r, r1[:len(r)])           # taken in order
     with pytest.raises(ValueError, match="point_half_width"):
-        history.construct(cfg, "rain", 0)
+        history.construct(cfg, "layer", 0)
     with pytest.raises(ValueError, match="history"):
         history.construct(cfg, "sieve", 0)
+
+
+def test_sieve_rain_follows_the_heap():
+    """The sieve spans footprint_fraction of the settled heap's footprint (the trim-th outlier
+    left out), never narrows, never narrower than the point source's row, and its grains fall
+    within it; a fraction outside (0, 1] is refused by name."""
+    from ncd.shared.sources import SieveRain
+    cfg = small_cfg(30)
+    d = history.mean_diameter(cfg)
+    src = SieveRain(cfg, np.random.default_rng(2), 0.0, history.grain_radii(cfg, 1))
+    assert src.half_width == pytest.approx(0.5 * cfg["source"]["slots"] * 2.2 * cfg["grains"]["radius_max"])
+    x = np.linspace(-20 * d, 20 * d, 41)
+    pos = np.column_stack([x, np.full_like(x, 0.5 * d)])
+    pos[-1, 0] = 200 * d                               # one grain rolled far away: trimmed
+    rad = np.full(len(x), 0.5 * d)
+    still, ok = np.zeros((len(x), 2)), np.ones(len(x), bool)
+    src.update_height(pos, rad, still, ok)
+    reach = np.sort(np.abs(pos[:, 0]) + rad)[-1 - cfg["rain"]["trim"]]
+    assert src.half_width == pytest.approx(cfg["rain"]["footprint_fraction"] * reach)
+    assert src.half_width < 25 * d
+    p, r = src.draw(pos, rad, 50)
+    assert len(r) > 0 and np.all(np.abs(p[:, 0]) <= src.half_width)
+    src.update_height(pos[:5], rad[:5], still[:5], ok[:5])   # fewer grains: the sieve keeps its width
+    assert src.half_width == pytest.approx(cfg["rain"]["footprint_fraction"] * reach)
+    bad = {**cfg, "rain": {**cfg["rain"], "footprint_fraction": 1.5}}
+    with pytest.raises(ValueError, match="footprint_fraction"):
+        SieveRain(bad, np.random.default_rng(2), 0.0)
+
+
+def test_the_comparison_finds_a_known_difference_and_not_a_null():
+    """compare.py on synthetic piles: groups drawn from one distribution are not different
+    (no measure below alpha / 6) and match in shape; a steeper, higher group with a hump
+    instead of a dip differs in shape, profile and dip."""
+    from ncd.figures.fig4_history import compare as hc
+    rng = np.random.default_rng(3)
+    xi = np.linspace(-1.3, 1.3, 131)
+    dip_fn = lambda prof: ha.dip_depth(prof, xi, 0.1, (0.25, 0.7))  # noqa: E731
+
+    def group(n, slope, apex, bump):
+        prof = (1 + bump * np.exp(-(xi / 0.2) ** 2))[None, None, :] + 0.05 * rng.standard_normal((n, 1, len(xi)))
+        shape = np.column_stack([slope + rng.standard_normal(n), apex + 0.5 * rng.standard_normal(n),
+                                 60 + 1.5 * rng.standard_normal(n)])
+        return dict(shape=shape, profile=prof, deviation=rng.normal(5, 3, (n, 2, 9)))
+
+    a, b = group(16, 16.0, 17.0, -0.3), group(16, 16.0, 17.0, -0.3)
+    out = hc.compare(a, b, xi, dip_fn, rng, 400, 400, 0.95)
+    p = hc.p_values(out)
+    assert hc.differing(p) == [] and hc.shape_matched(out["shape_rel"])
+    c = group(16, 5.0, 9.0, +0.3)
+    out = hc.compare(a, c, xi, dip_fn, rng, 400, 400, 0.95)
+    p = hc.p_values(out)
+    assert {"flank_slope", "apex_height", "profile_gap", "dip"} <= set(hc.differing(p))
+    assert not hc.shape_matched(out["shape_rel"]) and out["dip"][0] > 0.4      # A dips, C humps
+    # a 10 % steeper group: matched would be wrong at the 5 % tolerance
+    assert not hc.shape_matched([0.1, 0.0, 0.0]) and hc.shape_matched([0.049, -0.049, 0.0])
+    assert not hc.equivalence_resolved([-0.06, -0.01, -0.01], [0.01, 0.01, 0.01])
 
 
 def test_removing_grains_keeps_the_warm_start_of_the_others(uninterrupted):
@@ -155,14 +211,14 @@ def test_removing_grains_keeps_the_warm_start_of_the_others(uninterrupted):
         assert len(j) == 1 and np.array_equal(guess[j[0]], imp)
 
 
-def test_rain_on_a_finite_base_removes_the_grains_that_fall_off():
+def test_layer_on_a_finite_base_removes_the_grains_that_fall_off():
     cfg = small_cfg(40)
     cfg["surface"]["fit_range"] = [0.0, 1.0]      # a flank fit on a deposit a few grains high
     d = history.mean_diameter(cfg)
     info = {}
     L = 5.0 * d                                   # a base too narrow for 40 grains
-    scene, rec, ground, eq, frames = history.construct(cfg, "rain", 2, L, info=info)
-    ds = history.pile_dataset(cfg, "rain", 2, scene, rec, ground, eq, frames, L, info)
+    scene, rec, ground, eq, frames = history.construct(cfg, "layer", 2, L, info=info)
+    ds = history.pile_dataset(cfg, "layer", 2, scene, rec, ground, eq, frames, L, info)
     assert eq.at_rest
     assert np.all(np.abs(ground[0][:, 0]) <= L) and ds.sizes["ground"] < 12
     assert ds.attrs["n_removed"] > 0 and ds.sizes["grain"] + ds.attrs["n_removed"] == 40
@@ -242,20 +298,34 @@ def test_histories_use_the_same_grains(piles):
     members = sorted({m for _, m in by})
     assert len(members) >= 2
     for m in members:
-        p, r = by[("point", m)], by[("rain", m)]
+        p, r, y = by[("point", m)], by[("rain", m)], by[("layer", m)]
         n = p.sizes["grain"]
-        # both poured the same grains in the same order; the rain's grains that rolled off its
-        # finite base are counted, those left are the point pile's grains of the same index
-        assert p.attrs["n_poured"] == r.attrs["n_poured"] == n and p.attrs["n_removed"] == 0
-        assert r.sizes["grain"] + r.attrs["n_removed"] == n
+        # the point source and the rain pour the same grains in the same order onto the same ground
+        assert p.attrs["n_poured"] == r.attrs["n_poured"] == y.attrs["n_poured"] == n
+        assert p.attrs["n_removed"] == r.attrs["n_removed"] == 0
         np.testing.assert_array_equal(p.poured_index.values, np.arange(n))
         np.testing.assert_array_equal(r.radius.values, p.radius.values[r.poured_index.values])
-        # the rain's base is the member's ground cut at the point pile's base half-width
-        L = r.attrs["point_half_width"]
+        np.testing.assert_array_equal(r.ground_radius.values, p.ground_radius.values)
+        # the layer's grains that rolled off its finite base are counted, those left are the
+        # point pile's grains of the same index; its base is the member's ground cut at L
+        assert y.sizes["grain"] + y.attrs["n_removed"] == n
+        np.testing.assert_array_equal(y.radius.values, p.radius.values[y.poured_index.values])
+        L = y.attrs["point_half_width"]
         assert L == p.attrs["base_half_width"]
         inside = np.abs(p.ground_x.values) <= L
-        np.testing.assert_array_equal(r.ground_radius.values, p.ground_radius.values[inside])
-        assert np.all(np.abs(r.x.values) <= r.attrs["base_edge"])
+        np.testing.assert_array_equal(y.ground_radius.values, p.ground_radius.values[inside])
+        assert np.all(np.abs(y.x.values) <= y.attrs["base_edge"])
+
+
+def test_the_rain_builds_the_point_source_heap_and_the_controls_hold(analysis):
+    """The matched-shape comparison on the run's piles: the rain's mean heap within 5 % of the
+    point source's in flank slope, apex height and base half-width; two halves of the point
+    piles not different by the test; the layer different from the heap (shape and profile)."""
+    m = ha.comparison_summary(analysis, "rain")
+    assert m["matched"], m["shape"]
+    assert ha.comparison_summary(analysis, "same")["differing"] == []
+    layer = ha.comparison_summary(analysis, "layer")
+    assert {"flank_slope", "apex_height", "profile_gap"} <= set(layer["differing"]) and not layer["matched"]
 
 
 def test_exact_ranges_contain_the_history_angle(analysis, results):
@@ -453,15 +523,15 @@ def test_page_figure_and_sentences(analysis, piles, results):
     from ncd.pages.notebook import MIN_FONT_PT, text_layout
 
     first = {ds.attrs["history"]: ds for ds in piles if ds.attrs["member"] == 0}
-    fig = hp.figure(analysis, [first["point"], first["rain"]])
+    fig = hp.figure(analysis, [first["point"], first["rain"], first["layer"]])
     assert [ax.get_title(loc="left")[:3] for ax in fig.axes] == ["(a)", "(b)", "(c)", "(d)"]
     lay = text_layout(fig)
     assert lay["overlaps"] == [] and lay["min_font_pt"] >= MIN_FONT_PT
     plt.close(fig)
     k0 = analysis.kernel.values[0]
     text = hp.stress_text(analysis)
-    for h, name in (("point", "point source"), ("rain", "rain")):
-        assert f"{name} {float(analysis.dip_mean.sel(history=h, kernel=k0)):.3f}" in text
+    for h in analysis.history.values:
+        assert f"{hp.LABELS[h]} {float(analysis.dip_mean.sel(history=h, kernel=k0)):.3f}" in text
     out = hp.outside_band(analysis)
     assert (hp.outside_text(analysis) == "") == (out == [])
     for h, k, m, lo, hi in out:

@@ -1,6 +1,7 @@
 """results/index.html and the claims table: every sentence of the paper has a row, the
 verdicts follow the data, missing data give "not computed", run times come from the
 benchmark files."""
+import html
 import re
 from pathlib import Path
 
@@ -13,7 +14,17 @@ from ncd.figures.fig2_slope import claims as fig2
 from ncd.figures.fig4_pile import claims as fig4
 from ncd.pages import claims as C
 from ncd.pages.registry import JUDGES_BY_FIGURE
-from ncd.pages.report import UNGER, abstract, build_page, claim_rows, run_times, section_of, sentence_rows, tally
+from ncd.pages.report import (
+    SOURCES,
+    UNGER,
+    abstract,
+    build_page,
+    claim_rows,
+    run_times,
+    section_of,
+    sentence_rows,
+    tally,
+)
 from ncd.shared.verdict import CONSISTENT, DIFFERS, NOT_COMPUTED, NOT_TESTED, REPRODUCED, VERDICTS, Verdict, anchor
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -37,7 +48,7 @@ def test_every_claim_is_judged_or_has_a_reason():
         figs = [f for f, _ in C.measures_of(c["id"], JUDGES_BY_FIGURE)]
         assert figs or c["id"] in C.UNTESTED_REASONS, c["id"]
         assert sorted(set(figs)) == sorted(c["figures"]), (c["id"], figs, c["figures"])
-        assert section_of(c) in c["section"] or (c.get("source") == UNGER and section_of(c) == UNGER)
+        assert section_of(c) in c["section"] or (c.get("source") in SOURCES and section_of(c) == c["source"])
     known = set(JUDGES_BY_FIGURE)
     assert {f for c in C.CLAIMS for f in c["figures"]} <= known
 
@@ -45,7 +56,7 @@ def test_every_claim_is_judged_or_has_a_reason():
 @pytest.mark.skipif(not PAPER.exists(), reason="the paper's text is not beside the checkout")
 def test_every_quote_is_the_papers_wording():
     paper = _normal(PAPER.read_text(encoding="utf-8"))
-    missing = [c["id"] for c in C.CLAIMS if c.get("source") != UNGER and _normal(c["quote"]) not in paper]
+    missing = [c["id"] for c in C.CLAIMS if c.get("source") not in SOURCES and _normal(c["quote"]) not in paper]
     assert not missing, f"quotes not found in the paper: {missing}"
 
 
@@ -127,6 +138,51 @@ def test_claim_markdown_carries_the_index_verdict_and_anchor(tmp_path):
     assert '<a id="claim-s1-wedging-threshold"></a>' in text and f"**{REPRODUCED}**" in text
     rows = dict((c["id"], v) for c, _, v in claim_rows(tmp_path) if c["id"] == "s1-wedging-threshold")
     assert rows["s1-wedging-threshold"].value in text
+
+
+def _index_row(page, claim_id):
+    """The HTML of one sentence's row on the index page."""
+    at = page.index(f"id='{claim_id}'")
+    return page[at:page.index("</tr>", at)]
+
+
+def test_the_index_row_states_the_criterion_before_the_data_and_how_it_was_judged(tmp_path):
+    _sweep(tmp_path, [0.0, 0.0, 0.4, 0.6])
+    claim = C.CLAIM_BY_ID["s1-wedging-threshold"]
+    judged = fig1.fig1_threshold(tmp_path)
+    row = _index_row(build_page(tmp_path, ["fig1_wedged"], {}), claim["id"])
+    assert "Criterion (stated before the data)" in row and html.escape(claim["criterion"]) in row
+    assert "How it was judged" in row and html.escape(judged.criterion) in row
+    # a control: the row prints the table's text, whatever it says, and drops the function's when it says the same
+    mine = dict(claim, criterion="a made-up criterion, 42 runs")
+    row = _index_row(build_page(tmp_path, ["fig1_wedged"], {}, claims=[mine]), claim["id"])
+    assert "a made-up criterion, 42 runs" in row and html.escape(claim["criterion"]) not in row
+    same = dict(claim, criterion=judged.criterion)
+    row = _index_row(build_page(tmp_path, ["fig1_wedged"], {}, claims=[same]), claim["id"])
+    assert html.escape(judged.criterion) in row and "How it was judged" not in row
+
+
+def test_every_index_row_prints_its_criterion_even_without_data(tmp_path):
+    page = build_page(tmp_path, [], {})
+    for c in C.CLAIMS:
+        row = _index_row(page, c["id"])
+        assert "Criterion (stated before the data)" in row, c["id"]
+        for fig, text in C.criterion_texts(c).items():
+            assert html.escape(text) in row, (c["id"], fig)
+            if len(set(C.criterion_texts(c).values())) > 1:
+                assert f"{fig}: {html.escape(text)}" in row, (c["id"], fig)
+
+
+def test_the_page_block_states_its_own_pages_criterion(tmp_path):
+    _sweep(tmp_path, [0.0, 0.0, 0.4, 0.6])
+    text = C.claim_markdown("s1-wedging-threshold", tmp_path, fig1.JUDGES)
+    crit = C.CLAIM_BY_ID["s1-wedging-threshold"]["criterion"]
+    assert f"*Criterion (stated before the data):* {crit.rstrip('.')}." in text
+    assert f"*How it was judged:* {fig1.fig1_threshold(tmp_path).criterion}" in text
+    # a sentence judged by two pages: each page prints its own text, not the other's
+    dip = C.CLAIM_BY_ID["s5-dip"]["criterion"]
+    block = C.claim_markdown("s5-dip", tmp_path, fig4.JUDGES)
+    assert dip["fig4_pile"].rstrip(".") in block and dip["fig4_history"].rstrip(".") not in block
 
 
 def test_run_times_sum_the_benchmark_files(tmp_path):

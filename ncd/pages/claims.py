@@ -10,6 +10,10 @@ page prints :func:`claim_markdown` with its own table and the index page
 (:mod:`ncd.pages.report`) prints :func:`verdicts` over every figure's table
 (:mod:`ncd.pages.registry`): the same functions, so the two cannot disagree.  A claim no
 figure judges is listed as *not tested* with the reason in :data:`UNTESTED_REASONS`.
+Every row carries its ``criterion``, the test stated before the data (what is measured, over
+which set, the threshold and its reason); the pages print it under "Criterion (stated before
+the data)" and the judging function's own words under "How it was judged", so that a reader
+can hold the one against the other.
 
 Criteria follow the paper's wording: a "may" is judged over the cases it ranges over
 (cuts, steps, runs), a statement in R^2κ is tested in R^2κ, a claim about usable step
@@ -17,6 +21,7 @@ sizes counts only accurate runs.  One name, unit and sign per quantity: the *dip
 is the flank pressure minus the pressure under the apex (> 0 a dip) in units of the mean
 ground stress W/2L, on both Figure 4 pages.
 """
+import re
 from pathlib import Path
 
 import yaml
@@ -27,12 +32,68 @@ TABLE = Path(__file__).with_name("paper_claims.yaml")
 
 
 def load_claims(path=TABLE):
-    """The claims table: a list of dicts ``id, section, quote, figures``."""
+    """The claims table: a list of dicts ``id, section, quote, criterion, figures``.  A row
+    without a criterion, or with one per page that misses a page of its ``figures``, is
+    refused here (naming the row), so that no page prints a verdict without its test."""
     rows = yaml.safe_load(Path(path).read_text(encoding="utf-8"))
     ids = [r["id"] for r in rows]
     if len(set(ids)) != len(ids):
         raise ValueError(f"duplicate claim ids in {path}")
+    bad = [f"{r['id']}: {p}" for r in rows for p in criterion_problems(r, form_only=True)]
+    if bad:
+        raise ValueError(f"claims table {path}: " + "; ".join(bad))
     return rows
+
+
+# The kinds of criterion that name no number, by their opening words, and what each must
+# then say: why no control can be built, what would test it, why it is not judged.
+NO_THRESHOLD = {
+    "consistent:": ("no control",),
+    "not tested:": ("would",),
+    "not judged:": ("open question", "beyond the paper"),
+}
+
+
+def criterion_texts(claim):
+    """``{figure: criterion}`` of a row: one text for every page of its ``figures`` (``""``
+    for a row no page judges), or the row's own mapping figure -> text."""
+    c = claim.get("criterion")
+    if isinstance(c, dict):
+        return dict(c)
+    return {f: c for f in claim.get("figures") or [""]}
+
+
+def criterion_problems(claim, form_only=False):
+    """What is wrong with a row's ``criterion`` (an empty list: nothing).  The form: present,
+    non-empty text, one per page where it is a mapping.  Then the content (unless
+    ``form_only``): a judged text names a threshold (a number), else it opens with one of
+    :data:`NO_THRESHOLD` and says what that kind needs; a row no page judges is
+    "Not tested:"."""
+    c = claim.get("criterion")
+    figures = list(claim.get("figures") or [])
+    if not c:
+        return ["no criterion"]
+    if isinstance(c, dict):
+        if set(c) != set(figures):
+            return [f"criterion pages {sorted(c)} are not its figures {sorted(figures)}"]
+    elif not isinstance(c, str):
+        return [f"criterion must be a text or a mapping figure -> text, got {type(c).__name__}"]
+    texts = criterion_texts(claim)
+    problems = [f"empty criterion for {f or 'the row'}" for f, t in texts.items() if not isinstance(t, str) or not t.strip()]
+    if problems or form_only:
+        return problems
+    for fig, text in texts.items():
+        where = f" ({fig})" if fig else ""
+        low = text.strip().lower()
+        kind = next((k for k in NO_THRESHOLD if low.startswith(k)), None)
+        if not figures and kind != "not tested:":
+            problems.append("a row no page judges must open with \"Not tested:\"")
+        elif kind is None and not re.search(r"\d", text):
+            problems.append(f"names no threshold{where}: no number, and it does not open with one of "
+                            f"{', '.join(repr(k) for k in NO_THRESHOLD)}")
+        elif kind is not None and not any(w in low for w in NO_THRESHOLD[kind]):
+            problems.append(f"a {kind!r} criterion{where} must say " + " or ".join(repr(w) for w in NO_THRESHOLD[kind]))
+    return problems
 
 
 CLAIMS = load_claims()
@@ -118,22 +179,53 @@ def sentence_verdict(claim, rows):
     return got[0], text
 
 
-def criterion_of(claim, verdict):
-    """The criterion a page prints for a claim: the one stated beside the quote in the table
-    (``criterion``: what is measured, over which set, the threshold and its reason), written
-    before the data were looked at, else the judging function's own words."""
-    return claim.get("criterion") or verdict.criterion
+def criterion_of(claim, figure=""):
+    """The criterion stated beside the quote in the table, written before the data were looked
+    at (what is measured, over which set, the threshold and its reason): the text for
+    ``figure``'s evidence where the row has one per page, else the row's text."""
+    texts = criterion_texts(claim)
+    if figure in texts:
+        return texts[figure]
+    if len(set(texts.values())) == 1:
+        return next(iter(texts.values()))
+    return "; ".join(f"{f}: {t}" for f, t in texts.items())
+
+
+def figure_of(function):
+    """The page whose package holds a judging function (``ncd.figures.<figure>.claims`` or
+    ``ncd.studies.<study>.claims``), ``""`` for a function elsewhere."""
+    parts = getattr(function, "__module__", "").split(".")
+    return parts[2] if len(parts) > 3 and parts[:2] in (["ncd", "figures"], ["ncd", "studies"]) else ""
+
+
+def _same(a, b):
+    return " ".join(a.split()).rstrip(".").casefold() == " ".join(b.split()).rstrip(".").casefold()
+
+
+def how_judged(stated, verdict):
+    """The judging function's own criterion where it adds to the ``stated`` one: ``""`` when
+    it is empty (a measurement not computed) or says the same."""
+    own = (verdict.criterion or "").strip()
+    return "" if own in ("", "—") or _same(own, stated) else own
 
 
 def claim_markdown(claim_id, results, judges):
     """The block a figure's page prints for one claim, judged by the page's own table
     ``judges`` (its package's ``JUDGES``): the anchor the index links to, the quote, the
-    measured value and the verdict with its criterion (the index's own words)."""
+    criterion stated before the data (the table's, the text for this page), then per judging
+    function the measured value, the verdict and how the function judged it (the index's
+    own words)."""
     claim = CLAIM_BY_ID[claim_id]
     if claim_id not in judges:
         raise KeyError(f"claim {claim_id!r} is not judged by this page's table (its claims.py JUDGES)")
-    rows = [evaluate(fn, results, claim_id) for fn in judges[claim_id]]
     own = anchor(claim_id)
-    body = "\n\n".join((f'<a id="{v.anchor}"></a>' if v.anchor and v.anchor != own else "")
-                       + f"**{v.verdict}** — {v.value}. *Criterion:* {criterion_of(claim, v).rstrip('.')}." for v in rows)
+    blocks = []
+    for fn in judges[claim_id]:
+        v = evaluate(fn, results, claim_id)
+        stated = criterion_of(claim, figure_of(fn))
+        how = how_judged(stated, v)
+        blocks.append((f'<a id="{v.anchor}"></a>' if v.anchor and v.anchor != own else "")
+                      + f"*Criterion (stated before the data):* {stated.rstrip('.')}.\n\n"
+                      + f"**{v.verdict}** — {v.value}." + (f" *How it was judged:* {how.rstrip('.')}." if how else ""))
+    body = "\n\n".join(blocks)
     return f'<a id="{own}"></a>\n\n> {claim["section"]}: “{claim["quote"]}”\n\n{body}\n'

@@ -5,9 +5,11 @@ them in each figure's ``claims.py`` (:mod:`ncd.pages.registry`); a figure's page
 same :class:`~ncd.shared.verdict.Verdict` for the same claim, and each row links to that
 block (``html/<figure>.html#claim-<id>``) and to the data files it read.  One row per
 sentence: where several pages hold evidence, the row shows each page's number and one
-verdict by the sentence's rule.  The page opens with an abstract generated from the
-verdicts.  A claim no figure measures is a *not tested* row with the reason; a missing file
-gives *not computed*, never a crash, so the page builds while figures change.
+verdict by the sentence's rule, under the sentence's criterion stated before the data (the
+table's) and how each judging function applied it.  The page opens with an abstract
+generated from the verdicts.  A claim no figure measures is a *not tested* row with the
+reason; a missing file gives *not computed*, never a crash, so the page builds while
+figures change.
 """
 import csv
 import hashlib
@@ -17,11 +19,15 @@ from pathlib import Path
 import yaml
 
 from ncd.io.netcdf import git_commit, versions
-from ncd.pages.claims import CLAIMS, sentence_verdict, verdicts
+from ncd.pages.claims import CLAIMS, criterion_of, criterion_texts, how_judged, sentence_verdict, verdicts
 from ncd.pages.registry import JUDGES_BY_FIGURE
 from ncd.shared.verdict import BEYOND, CONSISTENT, DIFFERS, NOT_COMPUTED, NOT_TESTED, REPRODUCED
 
 UNGER = "unger2005"      # the source of the findings judged beyond the paper (Unger, Kertész & Wolf 2005)
+GENG = "geng2001"        # the construction-history experiments (Geng et al. 2001; Vanel et al. 1999)
+# the sources of the findings judged beyond the paper, each in a section of its own
+SOURCES = {UNGER: "Beyond the paper: Unger, Kertész & Wolf (2005)",
+           GENG: "Beyond the paper: construction history at matched shape (Geng et al. 2001; Vanel et al. 1999)"}
 
 
 def run_times(results, figure):
@@ -57,7 +63,7 @@ img.thumb{width:180px;border:1px solid #ddd}.small{font-size:13px;color:#555}"""
 
 SECTIONS = (("§1", "Introductory example"), ("§2", "Time-stepping computation"), ("§3", "Granular flow on a slope"),
             ("§4", "An equilibrium state"), ("§5", "The messages from history"), ("§6", "Conclusion"),
-            (UNGER, "Beyond the paper: Unger, Kertész & Wolf (2005)"))
+            *SOURCES.items())
 VERDICT_ORDER = (REPRODUCED, DIFFERS, CONSISTENT, BEYOND, NOT_TESTED, NOT_COMPUTED)
 
 
@@ -68,9 +74,9 @@ def _verdict_class(v):
 
 def section_of(claim):
     """The section a claim is filed under: the last paper section (§1–§6) its label names,
-    or the section of Unger et al.'s findings (a claim whose ``source`` is their paper)."""
-    if claim.get("source") == UNGER:
-        return UNGER
+    or the section of another source's findings (a claim whose ``source`` is in :data:`SOURCES`)."""
+    if claim.get("source") in SOURCES:
+        return claim["source"]
     found = [sec for sec, _ in SECTIONS if sec in claim["section"]]
     return found[-1] if found else SECTIONS[0][0]
 
@@ -137,6 +143,11 @@ def abstract(sentences):
     if sum(unger.values()):
         parts.append("Beyond the paper, the findings of Unger, Kertész &amp; Wolf at this run's size: "
                      + ", ".join(f"{k} {e(v)}" for v, k in unger.items() if k) + ".")
+    geng = [(c, rows) for c, rows, v, _ in sentences if c.get("source") == GENG]
+    for c, rows in geng:
+        parts.append(f"Beyond the paper, the construction-history contrast of Geng et al. and Vanel et al. "
+                     f"(<a href='#{e(c['id'])}'>{e(c['section'])}</a>): "
+                     + "; ".join(f"{e(v.verdict)}, {e(v.value)}" for _, v in rows) + ".")
     return "<div class='abstract'><p>" + "</p><p>".join(parts) + "</p></div>"
 
 
@@ -148,12 +159,24 @@ def _row(c, evidence, verdict, rule):
     measured = "<br><br>".join((f"<b>{e(fig)}</b>: " if several else "") + e(m.value) + "<br>"
                                + "<br>".join(f"<a class='small' href='{e(d)}'>{e(d)}</a>" for d in m.data)
                                for fig, m in evidence)
-    criteria = ("<br>".join((f"{e(fig)} ({e(m.verdict)}): " if several else "") + e(m.criterion) for fig, m in evidence)
-                if not c.get("criterion") else e(c["criterion"]))
     rule_text = f"<br><span class='small'><i>rule:</i> {e(rule)}</span>" if rule else ""
     return (f"<tr class='{_verdict_class(verdict)}' id='{e(c['id'])}'><td>{where}<br>"
             f"<span class='small'>{e(c['section'])}</span></td><td><blockquote>“{e(c['quote'])}”</blockquote></td>"
-            f"<td>{measured}</td><td><b>{e(verdict)}</b>{rule_text}<br><span class='small'>{criteria}</span></td></tr>")
+            f"<td>{measured}</td><td><b>{e(verdict)}</b>{rule_text}<br>{criterion_cell(c, evidence)}</td></tr>")
+
+
+def criterion_cell(c, evidence):
+    """The criterion of a row: the table's, stated before the data (one text, or each page's
+    where the row has one per page), then how each judging function judged it where its own
+    words add to that (:func:`ncd.pages.claims.how_judged`)."""
+    e = html.escape
+    texts = criterion_texts(c)
+    stated = ("<br>".join(f"{e(f)}: {e(t)}" for f, t in texts.items()) if len(set(texts.values())) > 1
+              else e(criterion_of(c)))
+    how = [(fig, m, how_judged(criterion_of(c, fig), m)) for fig, m in evidence]
+    how = [(f"{e(fig)} ({e(m.verdict)}): " if len(evidence) > 1 else "") + e(h) for fig, m, h in how if h]
+    return (f"<span class='small'><b>Criterion (stated before the data):</b> {stated}</span>"
+            + (f"<br><span class='small'><i>How it was judged:</i> {'<br>'.join(how)}</span>" if how else ""))
 
 
 def build_page(results, figures, config, claims=CLAIMS):
@@ -171,8 +194,8 @@ def build_page(results, figures, config, claims=CLAIMS):
     for sec, title in SECTIONS:
         rows = [_row(*s) for s in sentences if section_of(s[0]) == sec]
         if rows:
-            what = "the finding" if sec == UNGER else "the paper says"
-            body.append(f"<h2>{'' if sec == UNGER else e(sec) + ' '}{e(title)}</h2><table><tr><th>page</th>"
+            what = "the finding" if sec in SOURCES else "the paper says"
+            body.append(f"<h2>{'' if sec in SOURCES else e(sec) + ' '}{e(title)}</h2><table><tr><th>page</th>"
                         f"<th>{what}</th><th>measured in this run (data)</th><th>verdict (criterion)</th></tr>"
                         f"{''.join(rows)}</table>")
     figs = []
@@ -193,7 +216,9 @@ def build_page(results, figures, config, claims=CLAIMS):
 2005 (<a href="https://hal.science/hal-01824602">hal-01824602</a>). Every checkable sentence of the paper has one row
 ({sum(counts.values())} sentences, table <code>ncd/pages/paper_claims.yaml</code>). Every number is read from this
 run's data when the page is built, by the same function that writes the claim on its figure's page; the page link
-goes to that paragraph, the data links to the files read.</p>
+goes to that paragraph, the data links to the files read. Each row states its criterion as written in the table before
+the data (what is measured, over which set, the threshold and its reason) and, where its words differ, how the judging
+function applied it.</p>
 {abstract(sentences)}
 <p><b>Verdicts, one per sentence of the paper:</b> {e(summary)}. <span class="small">reproduced: the paper's
 statement holds by the criterion given; differs: it does not; consistent: it holds by construction of the method or

@@ -3,7 +3,12 @@
 * :class:`PointSource` -- a localized source above ``x = 0`` rising with the pile
   (Figure 4; such piles show a pressure dip under the apex in Vanel et al. 1999 and
   Geng et al. 2001);
-* :class:`RainSource` -- a uniform rain over ``|x| <= half_width`` (a hump in those experiments).
+* :class:`SieveRain` -- a rain through a sieve that follows the growing heap: it spans the
+  central part of the current heap's footprint, so that grains land on the heap and the
+  heap grows at its angle of repose, as the point source's does (the "rain" of those
+  experiments, which build heaps of the same shape by both procedures);
+* :class:`RainSource` -- a uniform rain over a fixed ``|x| <= half_width`` from the first
+  grain on: it deposits a layer, not a heap.
 
 Both expose ``update_height``, ``draw`` and the state a checkpoint needs.  Given
 ``radii``, grains come in that order (the same grains for both histories); otherwise
@@ -117,20 +122,69 @@ class RainSource(_Source):
     """Rain over ``|x| <= half_width``: ``sites`` positions drawn uniformly per attempt,
     at ``drop_height_d`` above the highest settled grain under the rain."""
 
-    def __init__(self, cfg, rng, y_ground, half_width, sites, radii=None):
+    def __init__(self, cfg, rng, y_ground, half_width, sites, radii=None, spread=0.0):
         if not (np.isfinite(half_width) and half_width > 0):
             raise ValueError(f"rain half_width = {half_width!r} must be > 0")
         super().__init__(cfg, rng, y_ground, float(half_width), radii)
         self.half_width, self.sites = float(half_width), int(sites)
-        self.spread = cfg["rain"].get("spread", 0.0) * np.sqrt(cfg["gravity"] * self.d)
+        self.spread = float(spread) * np.sqrt(cfg["gravity"] * self.d)
 
     def velocities(self, count):
         """Straight down at the inlet speed, plus a horizontal speed uniform in
-        ``± rain.spread sqrt(g d)`` (drawn after the positions; none when 0)."""
+        ``± spread sqrt(g d)`` (drawn after the positions; none when 0)."""
         v = super().velocities(count)
         if self.spread > 0:
             v[:, 0] = self.rng.uniform(-self.spread, self.spread, count)
         return v
+
+    def draw(self, pos, radius, limit):
+        new_p, new_r = [], []
+        pos, radius = self._near(pos, radius)
+        for x in self.rng.uniform(-self.half_width, self.half_width, self.sites):
+            if len(new_r) >= limit:
+                break
+            self._try(x, self._radius(), pos, radius, new_p, new_r)
+        return np.array(new_p).reshape(-1, 2), np.array(new_r)
+
+
+class SieveRain(_Source):
+    """A rain through a sieve that widens with the heap: ``sites`` positions per attempt,
+    uniform over ``|x| <= fraction * W``, ``W`` the current footprint half-width (the
+    ``trim``-th largest ``|x| + r`` of the settled grains, so that a grain rolled away does
+    not widen the sieve), never narrower than the point source's row of sites.
+
+    Why it builds the point source's heap: a uniform deposit over the central part of a
+    heap standing at its angle of repose raises that part evenly and steepens the flank
+    at the sieve's edge, which avalanches back to the angle of repose, so the heap stays
+    a cone at repose; a sieve wider than the heap (:class:`RainSource` at first) deposits
+    a layer instead."""
+
+    def __init__(self, cfg, rng, y_ground, radii=None):
+        r = cfg["rain"]
+        g = cfg["grains"]
+        self.min_half = 0.5 * cfg["source"]["slots"] * 2.2 * g["radius_max"]
+        super().__init__(cfg, rng, y_ground, self.min_half, radii)
+        self.fraction, self.sites, self.trim = float(r["footprint_fraction"]), int(r["sites"]), int(r["trim"])
+        if not 0.0 < self.fraction <= 1.0:
+            raise ValueError(f"rain.footprint_fraction = {self.fraction!r} must lie in (0, 1]")
+        self.half_width = self.min_half
+
+    def update_height(self, pos, radius, vel, age_ok):
+        """Widen the sieve to ``fraction`` of the settled heap's footprint (it never
+        narrows), then raise it above the settled grains under it."""
+        settled = age_ok & (np.hypot(vel[:, 0], vel[:, 1]) < self.settle_speed)
+        if settled.sum() > self.trim:
+            reach = np.sort(np.abs(pos[settled, 0]) + radius[settled])[-1 - self.trim]
+            self.half_width = max(self.half_width, self.min_half, self.fraction * float(reach))
+            self.half_span = self.half_width
+        super().update_height(pos, radius, vel, age_ok)
+
+    def state(self):
+        return {**super().state(), "half_width": self.half_width}
+
+    def restore(self, state, rng_state):
+        super().restore(state, rng_state)
+        self.half_width = self.half_span = float(state.get("half_width", self.min_half))
 
     def draw(self, pos, radius, limit):
         new_p, new_r = [], []

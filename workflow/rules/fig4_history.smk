@@ -1,13 +1,14 @@
-# Figure 4's claims as statistics over piles of two construction histories.
-#   construct  one pile (history point or rain, member m, n grains); a rain pile reads the
-#              point pile of its member (the rain falls over that pile's base width);
+# Figure 4's claims as statistics over piles of three construction histories.
+#   construct  one pile (history point, rain or layer, member m, n grains); a layer reads the
+#              point pile of its member (its rain falls over that pile's base width);
 #              checkpoints in results/fig4_history/checkpoints (resumed after a kill,
 #              removed at the end)                              -> piles/n<n>/<history>_<m>.nc
 #   exact      exact angle ranges over A ∩ C at the arching cuts of the first exact.piles
-#              members of each history (exact.solver: HiGHS's simplex, or Clarabel's
+#              members of the point and rain histories (exact.solver: HiGHS's simplex, or Clarabel's
 #              interior point for 10^4 grains; ncd.figures.fig4_history.exact)
 #                                                                -> exact/n<n>/<history>_<m>.nc
-#   analyse    ground stress, dip, arching over the piles       -> analysis_n<n>.nc
+#   analyse    shape match, ground stress, dip, arching over the piles, the comparison
+#              of the histories and its controls                -> analysis_n<n>.nc
 #   notebook   notebooks/fig4_history.ipynb                     -> results/figures/fig4_history.png|pdf
 # Size study (target fig4_history_size, not in the default run): the piles of this config and
 # of every overlay in fig4_history.size.overlays (a config file whose fig4_history section is
@@ -24,8 +25,8 @@ CFGH = section(FIGH)
 FH = f"results/{FIGH}"
 NH = CFGH["grains"]["n"]
 # the construction sees only what builds a pile (an analysis parameter does not rebuild the piles)
-SIM_KEYS = ("root_seed", "grains", "ground", "mu", "mu_ground", "gravity", "h", "source", "rain", "construction",
-            "surface")
+SIM_KEYS = ("root_seed", "grains", "ground", "mu", "mu_ground", "gravity", "h", "source", "rain", "layer",
+            "construction", "surface")
 
 
 def _size_sections():
@@ -54,14 +55,18 @@ def size_cfg(n):
     return SIZE_CFG[int(n)]
 
 
+HISTORIES_H = ("point", "rain", "layer")     # ncd.figures.fig4_history.construct.HISTORIES
+EXACT_HISTORIES = ("point", "rain")          # the heaps compared at matched shape
+
+
 def piles_of(n):
     c = size_cfg(n)
-    return [f"{FH}/piles/n{n}/{h}_{m:03d}.nc" for h in ("point", "rain") for m in range(c["piles"])]
+    return [f"{FH}/piles/n{n}/{h}_{m:03d}.nc" for h in HISTORIES_H for m in range(c["piles"])]
 
 
 def exact_of(n):
     c = size_cfg(n)
-    return [f"{FH}/exact/n{n}/{h}_{m:03d}.nc" for h in ("point", "rain")
+    return [f"{FH}/exact/n{n}/{h}_{m:03d}.nc" for h in EXACT_HISTORIES
             for m in range(min(c["exact"]["piles"], c["piles"]))]
 
 
@@ -71,12 +76,12 @@ FH_EXACT = exact_of(NH)
 
 rule fig4_history_construct:
     input:
-        point=lambda w: [] if w.history == "point" else f"{FH}/piles/n{w.n}/point_{w.member}.nc",
+        point=lambda w: f"{FH}/piles/n{w.n}/point_{w.member}.nc" if w.history == "layer" else [],
         code=code_of("fig4_history_construct"),
     output:
         f"{FH}/piles/n{{n}}/{{history}}_{{member}}.nc",
     wildcard_constraints:
-        history="point|rain",
+        history="point|rain|layer",
         member=r"\d+",
         n=r"\d+",
     params:
@@ -140,6 +145,7 @@ rule fig4_history_notebook:
         analysis=f"{FH}/analysis_n{NH}.nc",
         point=f"{FH}/piles/n{NH}/point_000.nc",
         rain=f"{FH}/piles/n{NH}/rain_000.nc",
+        layer=f"{FH}/piles/n{NH}/layer_000.nc",
         notebook=notebook_file(FIGH),
         notebook_py=notebook_file(FIGH, "py"),
         code=notebook_code("fig4_history"),

@@ -1,4 +1,5 @@
-"""Figure 4 over construction histories: ground stress, dip and arching over the piles (analysis_n<n>.nc)."""
+"""Figure 4 over construction histories: shape match, ground stress, dip and arching over the piles and the
+comparison of the histories with its controls (analysis_n<n>.nc)."""
 import xarray as xr
 
 from ncd.figures.fig4_history import analysis as history_analysis
@@ -23,4 +24,7 @@ for h in out.history.values:
     s = out.sel(history=h, kernel=k)
     log.info("%s: dip of the mean profile %.3f [%.3f, %.3f] (kernel %.1f d)", h, float(s.dip_mean),
              float(s.dip_lo), float(s.dip_hi), k)
-log.info("difference %s", out.dip_diff.values)
+for c in out.comparison.values:
+    m = history_analysis.comparison_summary(out, c)
+    log.info("%s: shapes matched %s (relative differences %s), differing measures %s", c, m["matched"],
+             {k: round(v["rel"], 4) for k, v in m["shape"].items()}, m["differing"])

@@ -14,7 +14,7 @@ w = snakemake.wildcards
 if int(w.n) != cfg["grains"]["n"]:
     raise InputError(f"file name n{w.n} differs from fig4_history.grains.n = {cfg['grains']['n']}")
 half = None
-if w.history == "rain":   # the finite base of the rain: the member's point-source pile's base half-width
+if w.history == "layer":   # the finite base of the layer: the member's point-source pile's base half-width
     with xr.open_dataset(snakemake.input.point) as p:
         half = float(p.attrs["base_half_width"])
 checkpoint = snakemake.params.checkpoint

@@ -1,4 +1,4 @@
-"""Ground pressure and arching over ensembles of piles of two histories (Moreau 2005, section 5).
+"""Ground pressure and arching over ensembles of piles of three histories (Moreau 2005, section 5).
 
 Per pile, from its history forces: the ground stress profile ``p(x / L)`` (kernel
 average of the ground contacts, normalised by the mean stress ``W / (2 L)``), the dip
@@ -7,13 +7,16 @@ sign of the single pile's dip in :mod:`ncd.figures.fig4_pile.pressure`) and the 
 vertical cuts at ``x = ± q L`` against the pile's flank slope.  Statistics resample piles,
 never runs of one pile.  The dip is a minimum against maxima of a noisier resampled
 profile, so its percentile band is biased upwards; the dip and difference bands are
-therefore *basic* bootstrap bands (:func:`basic_band`), correct to first order.
+therefore *basic* bootstrap bands (:func:`basic_band`), correct to first order.  The
+histories are compared at matched shape by :mod:`ncd.figures.fig4_history.compare`
+(:data:`COMPARISONS`: the test and its two controls).
 """
 import warnings
 
 import numpy as np
 import xarray as xr
 
+from ncd.figures.fig4_history import compare as cmp
 from ncd.figures.fig4_history.construct import HISTORIES, ground_forces
 from ncd.shared import cuts as cm
 from ncd.shared.pile import equilibrium_problem, final_scene
@@ -54,10 +57,11 @@ def dip_depth(profile, xi, center, flank):
 
 
 def norm_length(cfg, ds):
-    """``L`` of ``xi = x / L``: the base half-width of the member's point-source pile (for a
-    rain pile, the half-width of its finite base), so that both piles of a member share
-    the abscissa."""
-    return float(ds.attrs["point_half_width"])
+    """``L`` of ``xi = x / L``: the pile's own base half-width from its flank fits (point and
+    rain heaps), or for a layer the base half-width of the member's point-source pile, the
+    half-width of the layer's finite base."""
+    key = "point_half_width" if ds.attrs["history"] == "layer" else "base_half_width"
+    return float(ds.attrs[key])
 
 
 def pile_measures(cfg, ds):
@@ -136,6 +140,72 @@ def exact_arrays(exact, hist, n, shape):
     return lo, hi, out, done, confirmed
 
 
+# name: (group A, group B, role); a group is (history, members): None all, "even"/"odd" a half
+COMPARISONS = {
+    "rain": (("point", None), ("rain", None), "test: point source against the rain that builds the same heap"),
+    "layer": (("point", None), ("layer", None), "control: a difference known to exist (heap against layer)"),
+    "same": (("point", "even"), ("point", "odd"), "control: one history, different seeds (even against odd members)"),
+}
+
+
+def _members(n, which):
+    return np.arange(n) if which is None else np.arange(0 if which == "even" else 1, n, 2)
+
+
+def comparisons(cfg, an, hist, rng):
+    """The :data:`COMPARISONS` whose histories ``an`` holds, as variables over a ``comparison``
+    dimension (:func:`ncd.figures.fig4_history.compare.compare`), added to ``an``."""
+    a = cfg["analysis"]
+    xi = an.xi.values
+    d = an.attrs["mean_diameter"]
+    shape = np.stack([an.surface_angle.mean("flank").values, an.apex_height.values,
+                      an.fit_half_width.values / d], axis=-1)           # (history, pile, 3)
+    dip_fn = lambda prof: dip_depth(prof, xi, a["dip_center"], a["dip_flank"])  # noqa: E731
+    names, rows = [], []
+    n = an.sizes["pile"]
+    for name, (ga, gb, _) in COMPARISONS.items():
+        if ga[0] not in hist or gb[0] not in hist:
+            continue
+        groups = []
+        for h, which in (ga, gb):
+            i, m = hist.index(h), _members(n, which)
+            groups.append(dict(shape=shape[i, m], profile=an.profile.values[i, m],
+                               deviation=an.cut_deviation.values[i, m]))
+        names.append(name)
+        rows.append(cmp.compare(*groups, xi, dip_fn, rng, a["permutations"], a["bootstrap"], a["level"]))
+    if not names:
+        return an
+    C, S, K = "comparison", "shape", "kernel"
+    stack = lambda key: np.array([r[key] for r in rows])  # noqa: E731
+    spec = {
+        "shape_diff": ((C, S), "per shape measure", "mean of group B minus mean of group A"),
+        "shape_rel": ((C, S), "1", "relative difference of the mean shapes (B - A) / A"),
+        "profile_gap": ((C, K), "1", "largest gap between the mean ground stress profiles over |x| <= L (W/2L)"),
+        "dip_diff": ((C, K), "1", "dip depth of A's mean profile minus B's (W/2L)"),
+        "arching_diff": ((C,), "degree", "pooled median cut deviation of A minus B"),
+    }
+    keys = {"shape_diff": "shape", "shape_rel": "shape_rel", "profile_gap": "profile_gap", "dip_diff": "dip",
+            "arching_diff": "arching"}
+    for var, (dims, units, long) in spec.items():
+        k = keys[var]
+        an[f"cmp_{var}"] = (dims, stack(k), {"units": units, "long_name": long})
+        for end in ("lo", "hi"):
+            an[f"cmp_{var}_{end}"] = (dims, stack(f"{k}_{end}"), {"units": units, "long_name":
+                                      f"basic bootstrap band over piles of cmp_{var}, {'lower' if end == 'lo' else 'upper'}"})
+    for var, k, dims in (("shape", "p_shape", (C, S)), ("profile_gap", "p_profile_gap", (C, K)),
+                         ("dip", "p_dip", (C, K)), ("arching", "p_arching", (C,))):
+        an[f"cmp_p_{var}"] = (dims, stack(k), {"units": "1", "long_name": f"two-sided permutation p-value of the "
+                                                f"{var} difference (group labels shuffled over piles)"})
+    an["cmp_shape_reference"] = ((C, S), stack("shape_reference"), {"units": "per shape measure",
+                                                                  "long_name": "mean shape of group A"})
+    an = an.assign_coords({C: names, S: list(cmp.SHAPES)})
+    an[C].attrs.update(long_name="comparison: " + "; ".join(f"{k} = {COMPARISONS[k][0]} vs {COMPARISONS[k][1]} "
+                                                           f"({COMPARISONS[k][2]})" for k in names))
+    an[S].attrs.update(long_name="shape measure: flank slope (degree), apex height (d), base half-width (d)")
+    an.attrs.update(shape_tol=cmp.SHAPE_TOL, alpha=cmp.ALPHA)
+    return an
+
+
 def ensemble_dataset(cfg, files, exact=None):
     """analysis.nc from ``files = {history: [pile datasets in member order]}`` and the exact
     angle ranges ``exact = {(history, member): dataset}`` of some piles."""
@@ -157,12 +227,7 @@ def ensemble_dataset(cfg, files, exact=None):
     boot_dip = dip_depth(boot_mean, xi, a["dip_center"], a["dip_flank"])           # (history, B, width)
     mean = prof.mean(axis=1)
     dip_mean = dip_depth(mean, xi, a["dip_center"], a["dip_flank"])                # (history, width)
-    idx2 = bootstrap_index(rng, n, B)             # independent resamples of the second history
-    diff_boot = boot_dip[0] - dip_depth(prof[-1][idx2].mean(axis=1), xi, a["dip_center"], a["dip_flank"])
     dip_lo, dip_hi = basic_band(dip_mean, boot_dip, lo, hi, axis=1)
-    diff_lo, diff_hi = basic_band(dip_mean[0] - dip_mean[-1], diff_boot, lo, hi, axis=0)
-    p_value = np.array([permutation_p(dip_mean[0, j], dip_mean[-1, j], prof[0, :, j], prof[-1, :, j], xi,
-                                      a["dip_center"], a["dip_flank"], rng, a["permutations"]) for j in range(len(widths))])
     dev = stack("cut_deviation")                  # (history, pile, flank, position)
     ang = stack("cut_angle")
     q = np.asarray(a["cut_positions"], float)
@@ -182,10 +247,6 @@ def ensemble_dataset(cfg, files, exact=None):
             "dip_mean": one((H, K), dip_mean, "1", "dip depth M - m of the mean profile over piles, units of the mean ground stress W/2L, > 0 a dip"),
             "dip_lo": one((H, K), dip_lo, "1", "basic bootstrap band over piles of dip_mean, lower"),
             "dip_hi": one((H, K), dip_hi, "1", "basic bootstrap band over piles of dip_mean, upper"),
-            "dip_diff": one((K,), dip_mean[0] - dip_mean[-1], "1", f"dip_mean {hist[0]} minus {hist[-1]}"),
-            "dip_diff_lo": one((K,), diff_lo, "1", "basic bootstrap band of dip_diff, lower"),
-            "dip_diff_hi": one((K,), diff_hi, "1", "basic bootstrap band of dip_diff, upper"),
-            "dip_diff_p": one((K,), p_value, "1", "two-sided permutation p-value of dip_diff (labels over piles)"),
             "cut_deviation": one((H, P, F, Q), dev, "degree", "cut resultant angle minus free-surface slope "
                                  "(NaN: the cut crosses no contact)"),
             "cut_angle": one((H, P, F, Q), ang, "degree", "cut resultant angle below the horizontal, outward"),
@@ -202,7 +263,7 @@ def ensemble_dataset(cfg, files, exact=None):
                                        "bootstrap band over piles of the median deviation, upper"),
             "surface_angle": one((H, P, F), stack("surface_angle")[..., 0], "degree", "flank slope of the pile"),
             "base_half_width": one((H, P), stack("base_half_width"), "m",
-                                   "L: base half-width of the member's point-source pile"),
+                                   "L of x / L: the pile's own fitted base half-width (a layer: its point pile's)"),
             "fit_half_width": one((H, P), stack("fit_half_width"), "m", "toe-to-toe half-width of the pile's own fit"),
             "weight": one((H, P), stack("weight"), "N", "weight of the pile"),
             "ground_fx": one((H, P), stack("ground_fx"), "N", "horizontal ground reaction"),
@@ -230,7 +291,7 @@ def ensemble_dataset(cfg, files, exact=None):
     out[K].attrs.update(units="1", long_name="kernel standard deviation in mean grain diameters")
     out[X].attrs.update(units="1", long_name="x / base half-width")
     out[Q].attrs.update(units="1", long_name="cut position |x| / base half-width")
-    return out
+    return comparisons(cfg, out, hist, rng)
 
 
 def _nanmax(a):
@@ -267,3 +328,27 @@ def exact_summary(an, history):
                 exact_undefined=float(np.mean(np.isnan(width))),
                 exact_confirmed=float(np.mean(e.exact_confirmed.values, dtype=float)) if "exact_confirmed" in e else np.nan,
                 exact_outside_max=_nanmax(e.exact_history_outside.values))
+
+
+def comparison_summary(an, name, kernel=None):
+    """One comparison of ``an`` (:func:`comparisons`) at one kernel (default the first): the
+    shape differences with their bands, the match and its resolution, the p-values by
+    measure, the measures that differ (Bonferroni) and the differences with their bands.
+    Shared by the history page, its claims and the size study."""
+    s = an.sel(comparison=name)
+    k = an.kernel.values[0] if kernel is None else kernel
+    sk = s.sel(kernel=k)
+    rel, rlo, rhi = s.cmp_shape_rel.values, s.cmp_shape_rel_lo.values, s.cmp_shape_rel_hi.values
+    tol = float(an.attrs.get("shape_tol", cmp.SHAPE_TOL))
+    p = cmp.p_values({"p_shape": s.cmp_p_shape.values, "p_profile_gap": sk.cmp_p_profile_gap.values,
+                      "p_dip": sk.cmp_p_dip.values, "p_arching": s.cmp_p_arching.values})
+    return dict(name=name, kernel=float(k), tol=tol, alpha=float(an.attrs.get("alpha", cmp.ALPHA)),
+                shape={m: dict(rel=float(r), lo=float(lo), hi=float(hi), diff=float(dd), ref=float(ref))
+                       for m, r, lo, hi, dd, ref in zip(cmp.SHAPES, rel, rlo, rhi, s.cmp_shape_diff.values,
+                                                        s.cmp_shape_reference.values)},
+                matched=cmp.shape_matched(rel, tol), resolved=cmp.equivalence_resolved(rlo, rhi, tol),
+                p=p, differing=cmp.differing(p, float(an.attrs.get("alpha", cmp.ALPHA))),
+                dip=float(sk.cmp_dip_diff), dip_lo=float(sk.cmp_dip_diff_lo), dip_hi=float(sk.cmp_dip_diff_hi),
+                gap=float(sk.cmp_profile_gap), gap_lo=float(sk.cmp_profile_gap_lo), gap_hi=float(sk.cmp_profile_gap_hi),
+                arching=float(s.cmp_arching_diff), arching_lo=float(s.cmp_arching_diff_lo),
+                arching_hi=float(s.cmp_arching_diff_hi))

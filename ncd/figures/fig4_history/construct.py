@@ -1,22 +1,29 @@
-"""Piles of two construction histories (Moreau 2005, section 5): a point source and a rain.
+"""Piles of three construction histories (Moreau 2005, section 5): a point source, a rain
+that builds the same heap, and a layer.
 
 Member ``m`` of each history draws from independent generators
 ``default_rng((m, root_seed, stream))``: the ground and the grain radii are the same for
-both histories, only the source differs.  As in the experiments (Vanel et al. 1999; Geng
-et al. 2001) the rain falls over the base half-width ``L`` of the member's point pile onto
-a finite base, grains rolling off it are removed and the rain goes on until the pile
-holds as many grains as the point pile.  Construction: :func:`ncd.shared.construction.build`
-(checkpoints, frames); one netCDF file per pile.
+every history, only the source differs.
+
+* ``point``: Figure 4's localized source above the axis;
+* ``rain``: a rain through a sieve that follows the growing heap
+  (:class:`ncd.shared.sources.SieveRain`), as in the experiments that compare the two
+  procedures on heaps of the same shape (Vanel et al. 1999; Geng et al. 2001);
+* ``layer``: a uniform rain over the base half-width ``L`` of the member's point pile from
+  the first grain on, onto the finite base ``|x| <= L`` (grains rolling off it are removed):
+  it deposits a flat-topped layer, not a heap, and serves as the shape that differs.
+
+Construction: :func:`ncd.shared.construction.build` (checkpoints, frames); one netCDF file per pile.
 """
 import numpy as np
 
 from ncd.shared.construction import add_frames, build
 from ncd.shared.pile import add_to_pile, construction_dataset, free_surface, make_ground, pile_scene
-from ncd.shared.sources import PointSource, RainSource, mean_diameter
+from ncd.shared.sources import PointSource, RainSource, SieveRain, mean_diameter
 
-HISTORIES = ("point", "rain")
+HISTORIES = ("point", "rain", "layer")
 DROP_D = 2.0     # a grain this far (mean diameters) below the ground discs' centres has left the base
-STREAMS = {"ground": 0, "radii": 1, "point": 2, "rain": 3}
+STREAMS = {"ground": 0, "radii": 1, "point": 2, "layer": 3, "rain": 4}
 
 
 def member_rng(member, root_seed, stream):
@@ -52,7 +59,7 @@ def construct(cfg, history, member, point_half_width=None, log=None, checkpoint=
     """Build pile ``member`` of ``history``; returns :func:`build`'s tuple plus the ground.
 
     ``point_half_width`` (m, the base half-width ``L`` of the member's point-source pile)
-    is required for ``history == "rain"``: the rain falls over ``|x| <= width_fraction L``
+    is required for ``history == "layer"``: its rain falls over ``|x| <= width_fraction L``
     onto the finite base ``|x| <= L`` (:func:`finite_base`).  ``info`` (a dict) receives
     the insertion index of each grain and the removed grains (:func:`build`).
     """
@@ -66,26 +73,30 @@ def construct(cfg, history, member, point_half_width=None, log=None, checkpoint=
     drop, limit = None, None
     if history == "point":
         source = PointSource(cfg, rng, y0, radii)
+    elif history == "rain":
+        source = SieveRain(cfg, rng, y0, radii)
     else:
         if point_half_width is None or not np.isfinite(point_half_width) or point_half_width <= 0:
-            raise ValueError(f"history 'rain' needs point_half_width > 0 (the point-source pile's base "
+            raise ValueError(f"history 'layer' needs point_half_width > 0 (the point-source pile's base "
                              f"half-width), got {point_half_width!r}")
         ground = finite_base(ground, point_half_width)
-        limit = int(np.ceil(cfg["rain"]["pour_limit"] * len(radii)))
-        source = RainSource(cfg, rng, y0, cfg["rain"]["width_fraction"] * point_half_width,
-                            cfg["rain"]["sites"], grain_radii(cfg, member, limit))
+        limit = int(np.ceil(cfg["layer"]["pour_limit"] * len(radii)))
+        source = RainSource(cfg, rng, y0, cfg["layer"]["width_fraction"] * point_half_width,
+                            cfg["layer"]["sites"], grain_radii(cfg, member, limit), spread=cfg["layer"]["spread"])
         drop = -DROP_D * mean_diameter(cfg)
     c = cfg["construction"]
     key = {**cfg, "history": history, "member": int(member),
            "point_half_width": None if point_half_width is None else float(point_half_width)}
     factory = lambda p, r, v, w, a: pile_scene(cfg, p, r, *ground, vel=v, spin=w, angle=a)  # noqa: E731
     info = {} if info is None else info
-    if limit is not None:       # the rain pours `limit` grains; those that roll off the base are removed
+    if limit is not None:       # the layer pours `limit` grains; those that roll off the base are removed
         key["grains"] = {**cfg["grains"], "n": limit}
     scene, rec, eq, frames = build(key, ground, source, factory, log, checkpoint=checkpoint,
                                    checkpoint_every=c["checkpoint_every"], frame_every=c["frame_every"],
                                    drop_below=drop, info=info,
                                    add_grains=lambda s, p, r, v: add_to_pile(cfg, s, p, r, v))
+    if history == "rain":
+        info["sieve_half_width"] = float(source.half_width)    # the sieve's final half-width
     return scene, rec, ground, eq, frames
 
 
@@ -103,12 +114,17 @@ def pile_dataset(cfg, history, member, scene, rec, ground, eq, frames, point_hal
     removed = np.asarray(info.get("removed", np.zeros((0, 4))), float).reshape(-1, 4)
     ds["poured_index"] = ("grain", order, {"units": "1", "long_name": "insertion index of the grain (same "
                                            "sequence of radii for both histories of a member)"})
-    rain = history == "rain"
+    layer = history == "layer"
+    # point_half_width: the L of the member's point pile (its own for a point pile; a layer's
+    # base); a rain heap has none of its own and is read against its own base half-width
+    if history != "rain":
+        ds.attrs["point_half_width"] = float(point_half_width) if layer else float(L)
+    else:
+        ds.attrs["sieve_half_width"] = float(info.get("sieve_half_width", np.nan))
     ds.attrs.update(history=history, member=int(member), root_seed=int(cfg["root_seed"]), y_ground=y0,
                     base_half_width=float(L),
-                    point_half_width=float(point_half_width) if rain else float(L),
-                    rain_half_width=cfg["rain"]["width_fraction"] * float(point_half_width) if rain else np.nan,
-                    base_edge=float(np.max(np.abs(ground[0][:, 0]) + ground[1])) if rain else np.nan,
+                    layer_half_width=cfg["layer"]["width_fraction"] * float(point_half_width) if layer else np.nan,
+                    base_edge=float(np.max(np.abs(ground[0][:, 0]) + ground[1])) if layer else np.nan,
                     n_poured=int(nm + len(removed)), n_removed=int(len(removed)),
                     n_removed_left=int(np.sum(removed[:, 2] < 0)), n_removed_right=int(np.sum(removed[:, 2] > 0)),
                     construction_wall_time=float(np.sum(rec["wall_time"])),

@@ -4,13 +4,21 @@ The analyses of several pile sizes (``analysis_n<n>.nc`` of
 :mod:`ncd.figures.fig4_history.analysis`) side by side, per history: the dip depth and the
 median cut deviation with bootstrap bands over piles, and their change from the
 smallest size with a permutation p-value
-(:func:`ncd.figures.fig4_history.analysis.permutation_p`).  The abscissae are in units of the
+(:func:`ncd.figures.fig4_history.analysis.permutation_p`), and at each size the shape match
+of the rain's heap to the point source's (:mod:`ncd.figures.fig4_history.compare`).  The abscissae are in units of the
 base half-width, so profiles of every size compare directly.
 """
 import numpy as np
 import xarray as xr
 
-from ncd.figures.fig4_history.analysis import EXACT_SUMMARY, bootstrap_index, exact_summary, permutation_p
+from ncd.figures.fig4_history.analysis import (
+    EXACT_SUMMARY,
+    bootstrap_index,
+    comparison_summary,
+    exact_summary,
+    permutation_p,
+)
+from ncd.figures.fig4_history.compare import SHAPES
 
 
 def _pile_arching(an):
@@ -76,6 +84,16 @@ def size_dataset(analyses, seed=16):
         for i, h in enumerate(hist):
             for k, v in (exact_summary(an, h) or {"exact_piles": 0}).items():
                 exact[k][s, i] = v
+    # the shape match of the rain to the point source at each size (NaN: no rain piles)
+    match = {k: np.full((S, len(SHAPES)), np.nan) for k in ("rel", "lo", "hi")}
+    match_p = np.full((S, len(SHAPES)), np.nan)
+    for z, an in enumerate(ans):
+        if "comparison" in an.dims and "rain" in an.comparison.values:
+            m = comparison_summary(an, "rain")
+            for j, key in enumerate(SHAPES):
+                for q in ("rel", "lo", "hi"):
+                    match[q][z, j] = m["shape"][key][q]
+                match_p[z, j] = m["p"][key]
     stack = lambda v: np.array([an[v].values for an in ans])            # noqa: E731
     mean_over = lambda v: np.array([an[v].mean("pile").values for an in ans])   # noqa: E731
     d = ref.attrs["mean_diameter"]
@@ -116,11 +134,17 @@ def size_dataset(analyses, seed=16):
                               "toe-to-toe half-width of the pile's own fit in d, mean over piles"),
             "cone_ratio": one((Z, Hd), mean_over("cone_ratio"), "1", "cone ratio, mean over piles"),
             **{k: one((Z, Hd), exact[k], u, ln) for k, (u, ln) in EXACT_SUMMARY.items()},
+            "shape_rel": one((Z, "shape"), match["rel"], "1", "rain minus point source, relative difference of the "
+                             "mean piles (NaN: no rain piles)"),
+            "shape_rel_lo": one((Z, "shape"), match["lo"], "1", "basic bootstrap band of shape_rel, lower"),
+            "shape_rel_hi": one((Z, "shape"), match["hi"], "1", "basic bootstrap band of shape_rel, upper"),
+            "shape_p": one((Z, "shape"), match_p, "1", "two-sided permutation p-value of the shape difference"),
         },
         coords={Z: np.arange(S), Hd: hist, P: np.arange(n_max), Kd: K, F: ref.flank.values,
-                Q: ref.cut_position.values},
+                Q: ref.cut_position.values, "shape": list(SHAPES)},
         attrs={"level": a["level"], "bootstrap": a["bootstrap"], "permutations": a["permutations"],
-               "dip_center": a["dip_center"], "dip_flank": list(a["dip_flank"])},
+               "dip_center": a["dip_center"], "dip_flank": list(a["dip_flank"]),
+               "shape_tol": float(a.get("shape_tol", np.nan))},
     )
     out[Z].attrs.update(units="1", long_name="size index (grain counts ascending)")
     out[Kd].attrs.update(units="1", long_name="kernel standard deviation in mean grain diameters")

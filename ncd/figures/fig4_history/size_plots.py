@@ -1,6 +1,7 @@
 """The size study's page: the analyses of every pile size side by side (figure, summary,
 sentences), read from ``size.nc`` (:mod:`ncd.figures.fig4_history.size`)."""
 import matplotlib.pyplot as plt
+import numpy as np
 
 from ncd.figures.fig4_history.analysis import CERTIFIED_TEXT, EXACT_SUMMARY
 from ncd.figures.fig4_history.plots import COLORS
@@ -101,4 +102,26 @@ def finding(sz):
     return " ".join(
         f"{h}: from {g[0]} to {g[-1]} grains the dip depth of the mean profile (units of W/2L, > 0 a dip) changes "
         f"by {s[h]['dip_change']:+.3f} (permutation p = {s[h]['dip_p']:.2f}) and the arching deviation by "
-        f"{s[h]['arching_change']:+.1f}° (p = {s[h]['arching_p']:.2f})." for h in ("point", "rain"))
+        f"{s[h]['arching_change']:+.1f}° (p = {s[h]['arching_p']:.2f})." for h in sz.history.values) \
+        + " " + shape_text(sz)
+
+
+def shape_text(sz):
+    """The rain's heap against the point source's at every size: relative differences of the
+    mean piles with their bands, matched or not within the analysis' tolerance."""
+    if "shape_rel" not in sz:
+        return ""
+    tol = float(sz.attrs.get("shape_tol", 0.05))
+    parts = []
+    for z, n in enumerate(sz.grains.values):
+        rel = sz.shape_rel.isel(size=z)
+        if not np.isfinite(rel.values).all():
+            parts.append(f"{int(n)} grains: no rain piles.")
+            continue
+        lo, hi = sz.shape_rel_lo.isel(size=z).values, sz.shape_rel_hi.isel(size=z).values
+        ok = bool(np.all(np.abs(rel.values) <= tol))
+        parts.append(f"{int(n)} grains ({int(sz.piles.values[z])} piles per history): the rain's mean heap "
+                     + ("matches" if ok else "does not match") + f" the point source's within {100 * tol:g} % ("
+                     + ", ".join(f"{str(k).replace('_', ' ')} {100 * v:+.1f} % [{100 * a:+.1f}, {100 * b:+.1f}]"
+                                 for k, v, a, b in zip(sz.shape.values, rel.values, lo, hi)) + ").")
+    return " ".join(parts)
