@@ -56,10 +56,14 @@
 #    "The vertical cut's force is parallel to the surface" is $n_s\cdot\sigma e = 0$; "the
 #    surface-parallel cut's force is vertical" is $e\cdot\sigma n_s = 0$. A symmetric
 #    $\sigma$ makes them one statement.
-# 5. *Incipient failure.* The friction mobilized on the surface-parallel plane,
-#    $\tau/\sigma_n$, against $\tan\theta$ of the flank and against the friction of the most
-#    loaded plane, $\sin\varphi = (\sigma_1 - \sigma_2)/(\sigma_1 + \sigma_2)$; the principal
-#    directions along the flank.
+# 5. *Incipient failure.* The friction angle $\varphi$ of the piles' own grains, measured by
+#    tilting the default pile and the first point-source piles: gravity is turned towards one
+#    flank step by step, each tilt held until the pile is back at rest, until the flank fails
+#    at a tilt $\alpha_\mathrm{fail}$; $\varphi = \theta + \alpha_\mathrm{fail}$, $\theta$ the
+#    flank's fitted slope. Beside it, the friction mobilized on the surface-parallel plane,
+#    $\tau/\sigma_n$, against $\tan\theta$, against $\tan\varphi$ and against the friction of
+#    the most loaded plane, $\sin\varphi_\sigma = (\sigma_1 - \sigma_2)/(\sigma_1 + \sigma_2)$;
+#    the principal directions along the flank.
 #
 # Medians are over cuts and piles; bands are percentile bootstrap resamples of the **piles**.
 
@@ -84,6 +88,8 @@ ms = xr.load_dataset(inp.measures)
 exact = {Path(p).stem: xr.load_dataset(p) for p in getattr(inp, "exact", None) or
          sorted(glob(str(results / "fig4_bank" / "exact" / "*.nc")))}
 con = xr.load_dataset(getattr(inp, "construction", results / "fig4_pile" / "construction.nc"))
+tilt_path = Path(getattr(inp, "tilt", results / "fig4_bank" / "tilt.nc"))
+tilt = xr.load_dataset(tilt_path) if tilt_path.exists() else None
 
 
 def claim(claim_id):
@@ -91,11 +97,11 @@ def claim(claim_id):
     return Markdown(claim_markdown(claim_id, results, bc.JUDGES))
 
 # %%
-fig = bp.figure(ms, exact, con)
+fig = bp.figure(ms, exact, con, tilt)
 save(fig, out)
 
 # %%
-display(Markdown(bp.caption(ms)))
+display(Markdown(bp.caption(ms, tilt=tilt)))
 
 # %% [markdown]
 # ## <a id="surface-parallel-cuts"></a>Cuts parallel to the free surface
@@ -129,11 +135,16 @@ display(claim("s5-reciprocity"))
 display(Markdown(bpage.reciprocity_text(ms)))
 
 # %% [markdown]
-# ## <a id="incipient-failure"></a>Incipient failure as a stress state
+# ## <a id="incipient-failure"></a>Incipient failure: the tilting test and the stress state
+#
+# A bank "in a state of incipient failure" stands at the friction angle of its grains: tilted
+# by a little more than nothing, it fails. Panels (h, i) tilt the piles (the default pile and
+# the first point-source piles, each flank in turn).
 
 # %%
 display(claim("s5-incipient-failure"))
-display(Markdown(bpage.failure_text(ms)))
+display(Markdown(bpage.tilt_text(tilt, ms)))
+display(Markdown(bpage.failure_text(ms, tilt)))
 
 # %% [markdown]
 # ## <a id="three-d"></a>What the 2-D measurement can and cannot say about Moreau's 3-D piles

@@ -13,7 +13,7 @@ from ncd.pipeline.config import ConfigError, check_config
 SCHEMAS = ROOT / "workflow" / "schemas"
 CONFIG = yaml.safe_load((ROOT / "config.yaml").read_text())
 REDUCED = yaml.safe_load((ROOT / "tests" / "config_reduced.yaml").read_text())
-FULL = yaml.safe_load((ROOT / "config" / "full.yaml").read_text())
+QUICK = yaml.safe_load((ROOT / "config" / "quick.yaml").read_text())
 REALIZATIONS = {"runs", "piles", "seeds", "random_runs"}     # counts of ensemble members, piles, flows
 RULE_FILES = [f for f in CONFIG if (ROOT / "workflow" / "rules" / f"{f}.smk").exists() and f != "bench"]
 
@@ -49,18 +49,32 @@ def leaves(tree, path=()):
             yield path + (key,), value
 
 
-def test_the_full_overlay_only_draws_more_realizations():
-    """``config/full.yaml`` keeps every size, tolerance, method and seed of config.yaml:
-    it sets realization counts only, each above the default's (the default's members are
-    then its first ones)."""
-    check_config(merged(CONFIG, FULL), RULE_FILES, SCHEMAS)
-    assert len(list(leaves(FULL))) >= 8
-    for path, value in leaves(FULL):
+def test_the_quick_overlay_only_draws_fewer_realizations():
+    """``config/quick.yaml`` keeps every size, tolerance, method and seed of config.yaml: it
+    sets the run's label and realization counts only, each below the full run's (its members
+    are then the full run's first ones)."""
+    check_config(merged(CONFIG, QUICK), RULE_FILES, SCHEMAS)
+    assert CONFIG["run"]["label"] == "full" and QUICK["run"] == {"label": "quick"}
+    counts = [(p, v) for p, v in leaves(QUICK) if p != ("run", "label")]
+    assert len(counts) >= 8
+    for path, value in counts:
         default = CONFIG
         for key in path:
             default = default[key]
         assert path[-1] in REALIZATIONS, f"{'.'.join(path)} is not a realization count"
-        assert type(value) is int and value > default, (path, value, default)
+        assert type(value) is int and value < default, (path, value, default)
+
+
+def test_a_quick_run_says_so_with_its_counts():
+    """The notice of a quick run names its label and each figure's counts; the full run has none;
+    a label outside full/quick is refused naming the key."""
+    from ncd.pages.runscale import banner_html, counts
+    quick = merged(CONFIG, QUICK)
+    text = banner_html(quick, ["fig4_pile", "fig2_slope"])
+    assert "A quick run" in text and "fig4_pile.ensemble.runs = 64" in text and "fig2_slope.explore.runs = 500" in text
+    assert banner_html(CONFIG, ["fig4_pile"]) == ""
+    assert ("fig4_history.piles", 16) in counts(CONFIG, "fig4_history")
+    assert "run.label" in errors_of("run: {label: fast}")
 
 
 # the ten configs that passed the schemas and planned jobs, with the text the error must hold
@@ -95,7 +109,7 @@ def test_a_config_that_slipped_through_is_refused_naming_the_key(overlay, messag
     ("fig4_pile: {grains: {radius_min: 2.0e-3}}", "fig4_pile.grains.radius_min = 0.002 must be <= "),
     ("fig4_pile: {surface: {fit_range: [0.8, 0.2]}}", "fig4_pile.surface.fit_range = [0.8, 0.2]"),
     ("fig4_pile: {tolerance_study: {runs: 600}}", "fig4_pile.tolerance_study.runs = 600 must be <= "
-                                                  "fig4_pile.ensemble.runs = 64"),
+                                                  "fig4_pile.ensemble.runs = 200"),
     ("fig2_slope: {flow: {step: 101}}", "fig2_slope.flow.step = 101 must be <= fig2_slope.flow.n_steps = 100"),
     ("fig3_equilibrium: {modes: {zero: {runs: 1.0e+4}}}", "fig3_equilibrium.modes.zero.runs = 10000.0"),
     ("fig3_equilibrium: {solver: {max_sweeps: 20000.5}}", "fig3_equilibrium.solver.max_sweeps = 20000.5"),

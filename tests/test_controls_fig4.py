@@ -9,6 +9,8 @@ import pytest
 import xarray as xr
 
 from ncd.figures.fig4_bank import claims as bank
+from ncd.figures.fig4_bank import page as bpage
+from ncd.figures.fig4_bank import tilt
 from ncd.figures.fig4_bank.measure import PER_CUT, bank_dataset
 from ncd.figures.fig4_history import claims as hist
 from ncd.figures.fig4_history.analysis import basic_band, bootstrap_index, dip_depth
@@ -372,11 +374,83 @@ def test_reciprocity_is_consistent_and_reports_the_cuts_correlation(tmp_path):
     assert abs(r["corr"]) < 0.5 and f"correlate at {r['corr']:.2f}" in w.value
 
 
-def test_incipient_failure_not_tested_carries_the_measured_ratio(tmp_path):
-    v = bank.claim_incipient_failure(write_bank(tmp_path, psi_mean=0.0))
-    assert v.verdict == NOT_TESTED and "friction angle of the grains is not measured" in v.value
-    ratio = float(bank.load(tmp_path)[0].failure.sel(history="point"))
-    assert f"{ratio:.2f} tan θ" in v.value and ratio == pytest.approx(1.0, abs=0.05)
-    w = bank.claim_incipient_failure(write_bank(tmp_path, psi_mean=-8.0))
-    ratio2 = float(bank.load(tmp_path)[0].failure.sel(history="point"))
-    assert w.verdict == NOT_TESTED and ratio2 < 0.7 and f"{ratio2:.2f} tan θ" in w.value
+TILT_CFG = {"step_deg": 0.5, "max_deg": 20.0, "hold": 4.0, "max_hold": 40.0, "check_every": 10, "displaced_d": 0.5,
+            "grains": 10, "hysteresis_deg": 2.0}
+
+
+def _tilted_pile(rng, theta, alpha_fail):
+    """A :func:`ncd.figures.fig4_bank.tilt.tilt_pile` result: both flanks at slope ``theta`` failing at
+    the levels nearest ``alpha_fail`` (one per flank; NaN: no failure within max_deg)."""
+    al = tilt.levels(TILT_CFG)
+    flanks = []
+    for a in alpha_fail:
+        n = len(al) if np.isnan(a) else int(np.argmin(np.abs(al - a))) + 1
+        per = {k: np.full(len(al), np.nan) for k in ("displaced", "max_displacement", "ke_end", "ke_max", "sweeps",
+                                                     "held")}
+        per["displaced"][:n] = np.r_[np.zeros(n - 1), 12.0 if np.isfinite(a) else 0.0]
+        for k in ("max_displacement", "ke_end", "ke_max", "sweeps", "held"):
+            per[k][:n] = rng.uniform(0.1, 1.0, n)
+        flanks.append(dict(alpha_fail=float(al[n - 1]) if np.isfinite(a) else np.nan, failed=bool(np.isfinite(a)),
+                           steps=100 * n, **per))
+    return {"theta": np.full(2, theta) + rng.normal(0.0, 0.3, 2), "flanks": flanks, "d": 0.002, "n_grains": 1000}
+
+
+def write_tilt(tmp_path, theta, alpha, piles=6, spread=0.5, seed=5):
+    """tilt.nc of ``piles`` point-source piles (slope ``theta``, failure tilts about ``alpha``) and a
+    default pile, beside the measures of :func:`write_bank`."""
+    rng = np.random.default_rng(seed)
+    rows = [("default", "default", "construction.nc", _tilted_pile(rng, theta, [alpha, alpha]))]
+    rows += [(f"point_{i:03d}", "point", f"point_{i:03d}.nc",
+              _tilted_pile(rng, theta, alpha + spread * rng.standard_normal(2) if np.isfinite(alpha) else [alpha] * 2))
+             for i in range(piles)]
+    tilt.tilt_dataset({"tilt": TILT_CFG, "analysis": BANK_CFG["analysis"]}, rows).to_netcdf(
+        write_bank(tmp_path) / "fig4_bank" / "tilt.nc")
+    return tmp_path
+
+
+def _margin(path):
+    t = xr.load_dataset(path / "fig4_bank" / "tilt.nc")
+    return float(t.margin.sel(history="point")), t
+
+
+def test_incipient_failure_controls(tmp_path):
+    """A bank at its failure angle (a tilt of a degree fails it) reproduces the sentence; a gentle
+    layer (4° flanks of grains whose friction angle is near 19°: 15° of tilt) differs."""
+    v = bank.claim_incipient_failure(write_tilt(tmp_path, theta=20.0, alpha=1.0))
+    m, _ = _margin(tmp_path)
+    assert v.verdict == REPRODUCED and m == pytest.approx(1.0, abs=0.5) and f"α_fail of {m:.1f}° on median" in v.value
+    w = bank.claim_incipient_failure(write_tilt(tmp_path, theta=4.0, alpha=15.0))
+    m, t = _margin(tmp_path)
+    assert w.verdict == DIFFERS and m == pytest.approx(15.0, abs=0.5) and f"α_fail of {m:.1f}° on median" in w.value
+    # the measured friction angle, and the stress state beside it against tan of that angle
+    phi = float(np.median(t.theta_fail.values[t.pile_history.values == "point"]))
+    assert phi == pytest.approx(19.0, abs=1.0) and f"φ = θ + α_fail is {phi:.1f}° on median" in w.value
+    assert f"of the measured tan φ = {np.tan(np.radians(phi)):.3f}" in w.value
+    # a margin just above the threshold (step 0.5° + hysteresis 2°) differs: the band's upper end is judged
+    x = bank.claim_incipient_failure(write_tilt(tmp_path, theta=18.0, alpha=3.5, spread=0.3))
+    assert x.verdict == DIFFERS
+    # flanks that never fail within max_deg count above every failed flank
+    y = bank.claim_incipient_failure(write_tilt(tmp_path, theta=18.0, alpha=np.nan))
+    assert y.verdict == DIFFERS and "12 without failure up to 20°" in y.value
+
+
+def test_incipient_failure_with_one_pile_judges_its_larger_flank(tmp_path):
+    path = write_tilt(tmp_path, theta=18.0, alpha=1.0, piles=1, spread=0.0)
+    t = xr.load_dataset(path / "fig4_bank" / "tilt.nc")
+    assert np.isnan(float(t.margin_hi.sel(history="point")))
+    assert bank.claim_incipient_failure(path).verdict == REPRODUCED
+    one = tilt.tilt_dataset({"tilt": TILT_CFG, "analysis": BANK_CFG["analysis"]},
+                            [("point_000", "point", "p.nc", _tilted_pile(np.random.default_rng(1), 18.0, [1.0, 6.0]))])
+    one.to_netcdf(path / "fig4_bank" / "tilt.nc")
+    assert bank.claim_incipient_failure(path).verdict == DIFFERS
+
+
+def test_the_bank_pages_quote_the_flank_slope_of_fig4_history(tmp_path):
+    """θ of the point-source piles on the bank's pages is the median over piles and flanks of the
+    piles' fitted slopes, the number fig4_history prints for the same piles."""
+    ms = bank.load(write_bank(tmp_path, theta=17.3))[0]
+    theta = float(np.median(ms.surface_angle.values[ms.pile_history.values == "point"]))
+    assert bank.flank_slope(ms) == pytest.approx(theta) and theta == pytest.approx(17.3)
+    assert f"{theta:.1f}° on median over the piles' flanks" in bank.claim_surface_force_vertical(tmp_path).criterion
+    assert f"slope at {theta:.1f}° on median" in bpage.three_d_text(ms)
+    assert f"θ = {theta:.1f}° on median" in bpage.failure_text(ms)

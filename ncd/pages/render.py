@@ -160,9 +160,10 @@ def copy_mathjax(dest):
     return dest
 
 
-def render(executed, html_path, pages=()):
+def render(executed, html_path, pages=(), banner=""):
     """Write the clean HTML page of the executed notebook ``executed`` to ``html_path``;
-    ``pages``: the page names in reading order (its header's previous and next links)."""
+    ``pages``: the page names in reading order (its header's previous and next links);
+    ``banner``: HTML placed under the header (a quick run's notice, :mod:`ncd.pages.runscale`)."""
     from nbconvert import HTMLExporter
 
     nb = nbformat.read(executed, as_version=4)
@@ -174,7 +175,8 @@ def render(executed, html_path, pages=()):
     body, _ = exporter.from_notebook_node(nb, resources={"metadata": {"name": title_of(name)}})
     body = strip_external(body)
     body = body.replace("</head>", STYLE + "</head>", 1)
-    body = re.sub(r"(<body[^>]*>)", lambda m: m.group(1) + TOGGLE + nav_header(name, pages), body, count=1)
+    body = re.sub(r"(<body[^>]*>)", lambda m: m.group(1) + TOGGLE + nav_header(name, pages) + banner, body,
+                  count=1)
     html_path = Path(html_path)
     html_path.parent.mkdir(parents=True, exist_ok=True)
     html_path.write_text(body, encoding="utf-8")

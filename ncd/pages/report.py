@@ -21,6 +21,7 @@ import yaml
 from ncd.io.netcdf import git_commit, versions
 from ncd.pages.claims import CLAIMS, criterion_of, criterion_texts, how_judged, sentence_verdict, verdicts
 from ncd.pages.registry import JUDGES_BY_FIGURE
+from ncd.pages.runscale import banner_html
 from ncd.shared.verdict import BEYOND, CONSISTENT, DIFFERS, NOT_COMPUTED, NOT_TESTED, REPRODUCED
 
 UNGER = "unger2005"      # the source of the findings judged beyond the paper (Unger, Kertész & Wolf 2005)
@@ -212,6 +213,7 @@ def build_page(results, figures, config, claims=CLAIMS):
     return f"""<!DOCTYPE html><html lang="en"><head><meta charset="utf-8">
 <title>ncd: reproduction of Moreau (2005), claim by claim</title><style>{CSS}</style></head><body>
 <h1>Indetermination in the numerical simulation of granular systems — reproduced claim by claim</h1>
+{banner_html(config, figures)}
 <p>J. J. Moreau, <i>Indetermination in the numerical simulation of granular systems</i>, Powders and Grains
 2005 (<a href="https://hal.science/hal-01824602">hal-01824602</a>). Every checkable sentence of the paper has one row
 ({sum(counts.values())} sentences, table <code>ncd/pages/paper_claims.yaml</code>). Every number is read from this

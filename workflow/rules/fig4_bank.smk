@@ -5,13 +5,15 @@
 #              every pile, bootstrap bands over piles            -> measures.nc
 #   exact      exact angle ranges over A ∩ C at the surface-parallel cuts of the default
 #              pile and the first exact.members of each history  -> exact/<pile>.nc
+#   tilt       tilting test of the default pile and the first tilt.piles point-source piles:
+#              the tilt at which each flank fails                -> tilt.nc
 #   notebook   notebooks/fig4_bank.ipynb                         -> results/figures/fig4_bank.png|pdf
 # Uses the names of fig4_pile.smk and fig4_history.smk (included before this file, FIGURES order):
 # the configs that built the piles (CFG4_SIM, SIM_KEYS) and the pile files (piles_of(NH)).
 BANK_FIG = "fig4_bank"
 BANK_CFG = section(BANK_FIG)
 BANK_DIR = f"results/{BANK_FIG}"
-BANK_MEASURE_CFG = {k: v for k, v in BANK_CFG.items() if k != "exact"}
+BANK_MEASURE_CFG = {k: v for k, v in BANK_CFG.items() if k not in ("exact", "tilt")}
 BANK_EXACT = ["default"] + [f"{h}_{m:03d}" for h in ("point", "rain")
                             for m in range(min(BANK_CFG["exact"]["members"], CFGH["piles"]))]
 
@@ -27,7 +29,12 @@ def bank_pile(name):
 # the config sections that built the piles (their equilibrium problems for the exact LPs), bound now:
 # a name of another rules file could be rebound by a later include before a params function runs
 BANK_PILE_CFG = {True: dict(CFG4_SIM), False: {k: CFGH[k] for k in SIM_KEYS}}
-BANK_EXACT_CFG = {k: v for k, v in BANK_CFG.items() if k not in ("analysis", "vertical_tol_deg", "failure_tol")}
+BANK_EXACT_CFG = {k: v for k, v in BANK_CFG.items() if k not in ("analysis", "vertical_tol_deg", "failure_tol", "tilt")}
+# the tilting test: its own section and the bootstrap of the bands; the point-source piles it tilts
+BANK_TILT_CFG = {"tilt": BANK_CFG["tilt"], "analysis": BANK_CFG["analysis"]}
+BANK_TILT_PILES = [f"{BANK_HISTORY_PILES}/point_{m:03d}.nc"
+                   for m in range(min(BANK_CFG["tilt"]["piles"], CFGH["piles"]))]
+BANK_TILT_PILE_CFG = {"default": BANK_PILE_CFG[True], "point": BANK_PILE_CFG[False]}
 
 
 rule fig4_bank_measure:
@@ -72,10 +79,32 @@ rule fig4_bank_exact:
         "../scripts/fig4_bank_exact.py"
 
 
+rule fig4_bank_tilt:
+    input:
+        construction="results/fig4_pile/construction.nc",
+        cuts="results/fig4_pile/cuts.nc",
+        piles=BANK_TILT_PILES,
+        code=code_of("fig4_bank_tilt"),
+    output:
+        f"{BANK_DIR}/tilt.nc",
+    params:
+        config=BANK_TILT_CFG,
+        pile_config=BANK_TILT_PILE_CFG,
+    log:
+        log(BANK_FIG, "tilt"),
+    benchmark:
+        bench(BANK_FIG, "tilt")
+    conda:
+        CONDA_ENV
+    script:
+        "../scripts/fig4_bank_tilt.py"
+
+
 rule fig4_bank_notebook:
     input:
         measures=f"{BANK_DIR}/measures.nc",
         exact=[f"{BANK_DIR}/exact/{p}.nc" for p in BANK_EXACT],
+        tilt=f"{BANK_DIR}/tilt.nc",
         construction="results/fig4_pile/construction.nc",
         cuts="results/fig4_pile/cuts.nc",
         notebook=notebook_file(BANK_FIG),

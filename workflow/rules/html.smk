@@ -1,4 +1,6 @@
 # Rules shared by every figure (included after common.smk, which holds only helpers):
+from ncd.pages.runscale import banner_html
+
 #   html_mathjax  MathJax copied beside the pages          -> results/html/mathjax/
 #   render_html   executed notebook -> clean offline page, with links to the index and
 #                 the neighbouring pages               -> results/html/<figure>.html
@@ -35,6 +37,7 @@ rule render_html:
     params:
         executed="results/notebooks/{figure}.ipynb",
         pages=FIGURES,
+        banner=lambda w: banner_html(config, [w.figure]),   # a quick run's notice (ncd.pages.runscale)
     log:
         "results/logs/{figure}/render_html.log",
     benchmark:

@@ -5,4 +5,4 @@ from ncd.pipeline.jobs import start
 log = start(snakemake)  # snakemake is injected
 log.info("%s -> %s", snakemake.params.executed,
          render(snakemake.params.executed, snakemake.output.html,
-                pages=snakemake.params.pages))
+                pages=snakemake.params.pages, banner=snakemake.params.banner))

@@ -5,7 +5,7 @@ Each function reads ``results/fig4_bank`` and returns a :class:`ncd.shared.verdi
 holding the evidence); the figure's page prints the same objects.  Moreau's piles are
 poured from a localized source: the claims are judged on the point-source piles of
 ``fig4_history`` (bootstrap bands over piles), the default pile of ``fig4_pile`` quoted
-beside them; the rained deposits are reported on the page only.
+beside them; the rained heaps of the same shape and the layers are reported on the page only.
 """
 import warnings
 from pathlib import Path
@@ -13,11 +13,12 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from ncd.shared.verdict import CONSISTENT, DIFFERS, NOT_COMPUTED, NOT_TESTED, REPRODUCED, Verdict
+from ncd.shared.verdict import CONSISTENT, DIFFERS, NOT_COMPUTED, REPRODUCED, Verdict
 from ncd.shared.verdict import anchor as claim_anchor
 
 MEASURES = "fig4_bank/measures.nc"
 EXACT = "fig4_bank/exact"
+TILT = "fig4_bank/tilt.nc"
 CLAIM_HISTORY = "point"
 ASYMMETRY_TOL = 1e-6     # |sigma_xy - sigma_yx| / p allowed of an equilibrium solved to 1e-10 or an LP vertex
 
@@ -66,6 +67,13 @@ def exact_summary(exact):
                 history_outside=nan_stat(np.nanmax, out) if np.isfinite(out).any() else np.nan)
 
 
+def flank_slope(ms, history=CLAIM_HISTORY):
+    """θ of ``history``'s piles: the median over piles and both flanks of each pile's fitted flank
+    slope (its fit by :func:`ncd.shared.pile.free_surface`, the one every page reads for that
+    pile; fig4_history quotes the same median for its point-source piles)."""
+    return nan_stat(np.nanmedian, ms.surface_angle.values[ms.pile_history.values == history])
+
+
 def vertical_numbers(ms):
     """The numbers of the first claim (point-source piles, and the default pile)."""
     h = CLAIM_HISTORY
@@ -79,7 +87,7 @@ def vertical_numbers(ms):
                q25=nan_stat(np.nanquantile, ang, 0.25), q75=nan_stat(np.nanquantile, ang, 0.75), by_depth=by_depth,
                load=float(s["carried"]), load_lo=float(s["carried_lo"]), load_hi=float(s["carried_hi"]), tol=float(ms.attrs["vertical_tol_deg"]),
                level=float(ms.attrs["level"]),
-               theta=float(np.degrees(np.arctan(nan_stat(np.nanmedian, of_history(ms, "tan_flank", h))))))
+               theta=flank_slope(ms, h))
     if "default" in ms.history.values:
         d = of_history(ms, "angle_to_vertical", "default")
         out.update(default=float(ms.angle.sel(history="default")), default_cuts=int(np.isfinite(d).sum()))
@@ -115,7 +123,7 @@ def claim_surface_force_vertical(results):
                    f"over cuts and piles: the {100 * v['level']:g} % bootstrap band over the point-source piles of the "
                    f"median angle between the surface-parallel cut resultant and the vertical lies within ±{tol:g}°, "
                    f"pooled and at every depth (the plane's normal, the direction of a force without shear, lies the "
-                   f"flank angle θ ≈ {v['theta']:.0f}° from the vertical)", anchor, files)
+                   f"flank slope θ from the vertical, {v['theta']:.1f}° on median over the piles' flanks)", anchor, files)
 
 
 def observation_correlation(ms, history=CLAIM_HISTORY):
@@ -190,32 +198,85 @@ def failure_numbers(ms):
     return out
 
 
+def load_tilt(results):
+    """tilt.nc under ``results``, or None when absent."""
+    path = Path(results) / TILT
+    return xr.load_dataset(path) if path.exists() else None
+
+
+def tilt_numbers(tilt, history=CLAIM_HISTORY):
+    """The tilting test of ``history``'s piles: flanks, failure tilts (a flank without failure at
+    ``max_deg + step_deg``), their median and band over piles, the failure angles and slopes,
+    the threshold ``step_deg + hysteresis_deg``."""
+    sel = tilt.pile_history.values == history
+    fail = tilt.alpha_fail.values[sel]
+    cens = np.where(np.isfinite(fail), fail, tilt.attrs["max_deg"] + tilt.attrs["step_deg"])
+    out = dict(piles=int(sel.sum()), flanks=int(fail.size), failed=int(np.isfinite(fail).sum()),
+               margin=float(tilt.margin.sel(history=history)), lo=float(tilt.margin_lo.sel(history=history)),
+               hi=float(tilt.margin_hi.sel(history=history)), alpha_min=float(cens.min()), alpha_max=float(cens.max()),
+               theta=float(np.median(tilt.theta.values[sel])),
+               theta_fail=nan_stat(np.nanmedian, tilt.theta_fail.values[sel]),
+               theta_fail_lo=nan_stat(np.nanmin, tilt.theta_fail.values[sel]),
+               theta_fail_hi=nan_stat(np.nanmax, tilt.theta_fail.values[sel]),
+               step=float(tilt.attrs["step_deg"]), hysteresis=float(tilt.attrs["hysteresis_deg"]),
+               max_deg=float(tilt.attrs["max_deg"]), level=float(tilt.attrs["level"]))
+    out["threshold"] = out["step"] + out["hysteresis"]
+    # the upper end judged: the band over piles, or with one pile its larger flank
+    out["upper"] = out["hi"] if np.isfinite(out["hi"]) else out["alpha_max"]
+    return out
+
+
 def claim_incipient_failure(results):
     """"... amounting to the assertion, commonly made in Civil Engineering, that the peripheral bank
-    lies in a state of incipient failure": not tested.  Incipient failure means the friction
-    mobilized on the surface-parallel planes equals the material's own friction angle, which no
-    run measures; tau / sigma_n over tan(theta) is tan(theta + psi) / tan(theta), psi the angle
-    of the surface-parallel force to the vertical: the vertical-force row again.  The value
-    carries the measured ratio."""
+    lies in a state of incipient failure": the bank stands at the friction angle of its grains.
+    That angle is measured by tilting the piles (:mod:`ncd.figures.fig4_bank.tilt`): gravity
+    turned towards a flank in steps until the flank fails; its margin ``alpha_fail`` is how far
+    the bank stands below failure.  Judged on the point-source piles (both flanks, bootstrap
+    band over piles of the median margin): at incipient failure the margin is within the tilt
+    step plus the hysteresis between the angle of repose a pile is left at and its maximum
+    angle of stability (about 2° for spheres, Jaeger, Liu & Nagel, PRL 62, 40, 1989): a poured
+    bank stops at the former and fails at the latter.  The stress state is quoted beside it, not
+    judged: tau / sigma_n on the surface-parallel planes against the measured tan phi (it is
+    tan(theta + psi), psi the vertical-force row's angle, so only the tilt adds a number)."""
     ms, _ = load(results)
+    tilt = load_tilt(results)
     anchor = claim_anchor("s5-incipient-failure")
-    if ms is None or CLAIM_HISTORY not in ms.history.values:
-        return _missing(anchor, "The stress windows")
-    f = failure_numbers(ms)
-    text = (f"The friction angle of the grains is not measured; the mobilized ratio τ/σ_n on the surface-parallel "
-            f"planes is {f['ratio']:.2f} tan θ on median over {f['windows']} windows of {f['piles']} point-source piles "
-            f"({100 * f['level']:g} % band over piles {f['lo']:.2f} to {f['hi']:.2f}; from the cuts' own resultants "
-            f"{f['direct']:.2f})")
-    if "default" in f:
-        text += f", default pile {f['default']:.2f}"
-    text += (f": the same statement as the vertical-force row (a vertical force gives τ/σ_n = tan θ on any slope). "
-             f"It is {f['share']:.2f} of the friction tan φ = {f['tan_phi']:.2f} mobilized on the most loaded plane "
-             f"of the same windows, a property of the stress, not of the material.")
-    return Verdict(text, NOT_TESTED,
-                   "not tested: incipient failure means the friction mobilized on the surface-parallel planes equals "
-                   "the material's friction angle φ, which no run measures (a tilting or shear test of the same "
-                   "grains would); τ/σ_n ÷ tan θ = tan(θ + ψ)/tan θ only repeats the vertical-force row",
-                   anchor, (MEASURES,))
+    if tilt is None or CLAIM_HISTORY not in tilt.history.values:
+        return Verdict(f"The tilting test not computed in this run (no {TILT}).", NOT_COMPUTED, "", anchor, (TILT,))
+    n = tilt_numbers(tilt)
+    ok = n["upper"] <= n["threshold"]
+    text = (f"Tilted flank by flank, the {n['flanks']} flanks of {n['piles']} point-source piles (slope θ "
+            f"{n['theta']:.1f}° on median) fail after a tilt α_fail of {n['margin']:.1f}° on median "
+            + (f"({100 * n['level']:g} % band over piles {n['lo']:.1f}° to {n['hi']:.1f}°; " if np.isfinite(n['hi'])
+               else "(")
+            + f"single flanks {n['alpha_min']:.1f}° to {n['alpha_max']:.1f}°"
+            + (f", {n['flanks'] - n['failed']} without failure up to {n['max_deg']:g}°" if n["failed"] < n["flanks"]
+               else "")
+            + f"): the measured friction angle φ = θ + α_fail is {n['theta_fail']:.1f}° on median "
+            f"({n['theta_fail_lo']:.1f}° to {n['theta_fail_hi']:.1f}°)")
+    if "default" in tilt.history.values:
+        d = tilt.sel(pile=tilt.pile.values[tilt.pile_history.values == "default"][0])
+        text += "; default pile " + ", ".join(
+            f"{f} {float(d.alpha_fail.sel(flank=f)):.1f}°" if int(d.failed.sel(flank=f)) else f"{f} > {n['max_deg']:g}°"
+            for f in d.flank.values)
+    files = (TILT,)
+    if ms is not None and CLAIM_HISTORY in ms.history.values and np.isfinite(n["theta_fail"]):
+        f = failure_numbers(ms)
+        tan_fail = float(np.tan(np.radians(n["theta_fail"])))
+        text += (f". Beside it (not judged): τ/σ_n on the surface-parallel planes is {f['mobilized']:.3f} on median, "
+                 f"{f['mobilized'] / tan_fail:.2f} of the measured tan φ = {tan_fail:.3f} ({f['ratio']:.2f} tan θ); the "
+                 f"most loaded plane of the same windows mobilizes {f['tan_phi']:.3f}, {f['tan_phi'] / tan_fail:.2f} of "
+                 f"it, and the surface-parallel plane {f['share']:.2f} of the most loaded one; the major principal "
+                 f"direction lies {f['major']:+.1f}° from the vertical (a slope at failure: "
+                 f"{-(45 - n['theta_fail'] / 2):+.1f}°)")
+        files = (TILT, MEASURES)
+    return Verdict(text, REPRODUCED if ok else DIFFERS,
+                   f"over the tested flanks of the point-source piles: the upper end of the {100 * n['level']:g} % "
+                   f"bootstrap band over piles of the median tilt α_fail that makes a flank fail is at most "
+                   f"{n['threshold']:g}° (the tilt step {n['step']:g}° plus the hysteresis of about "
+                   f"{n['hysteresis']:g}° between the angle of repose and the maximum angle of stability, Jaeger, Liu & "
+                   f"Nagel 1989); failure: at least {int(tilt.attrs['grains'])} grains of the tilted side moved more "
+                   f"than {float(tilt.attrs['displaced_d']):g} d", anchor, files)
 
 
 # the judging functions of this package's rows, by claim id (ncd.pages.claims renders them)

@@ -21,7 +21,8 @@ from ncd.figures.fig4_bank import stress as st
 from ncd.shared import cuts as cm
 
 FLANKS = (("left", -1), ("right", 1))
-HISTORY_LABELS = {"default": "default pile (fig4_pile)", "point": "point source", "rain": "rain"}
+HISTORY_LABELS = {"default": "default pile (fig4_pile)", "point": "point source", "rain": "rain (same heap)",
+                  "layer": "layer"}
 
 
 def _nan(stat, a, *args, **kw):

@@ -7,10 +7,12 @@ from ncd.figures.fig4_bank.claims import (
     CLAIM_HISTORY,
     exact_summary,
     failure_numbers,
+    flank_slope,
     nan_stat,
     observation_correlation,
     of_history,
     reciprocity_numbers,
+    tilt_numbers,
     vertical_numbers,
 )
 
@@ -34,13 +36,14 @@ def cuts_text(ms):
         if h == CLAIM_HISTORY:
             continue
         a = of_history(ms, "angle_to_vertical", h)
-        label = "The default pile" if h == "default" else "The rained deposits"
+        label = {"default": "The default pile", "rain": "The rained heaps (the point source's shape)",
+                 "layer": "The layers"}.get(str(h), str(h))
         lines.append(f"{label}: {float(ms.angle.sel(history=h)):+.1f}° on median over {int(np.isfinite(a).sum())} "
                      f"cuts (half between {nan_stat(np.nanquantile, a, 0.25):+.1f}° and "
                      f"{nan_stat(np.nanquantile, a, 0.75):+.1f}°), carrying {float(ms['carried'].sel(history=h)):.3f} "
                      f"times the column weight"
                      + (f"; their fitted flanks slope at only {nan_stat(np.nanmedian, of_history(ms, 'tan_flank', h)):.2f} "
-                        "(tan), so their cuts are nearly horizontal." if h == "rain" else "."))
+                        "(tan), so their cuts are nearly horizontal." if h == "layer" else "."))
     return " ".join(lines)
 
 
@@ -119,35 +122,74 @@ def reciprocity_text(ms):
             f"averaged stress; the single cuts obey it only up to their sampling of a few contacts.")
 
 
-def failure_text(ms):
+def failure_text(ms, tilt=None):
     """tau / sigma_n against tan(flank) and tan(phi) of the most loaded plane, and the principal
-    directions against those of a slope at the limit (Mohr circle touching tan(theta) on the
-    surface-parallel planes: the major direction leans towards the axis by 45° - theta/2)."""
+    directions against those of a slope at the limit (Mohr circle touching tan(phi) on the
+    surface-parallel planes: the major direction leans towards the axis by 45° - phi/2), phi the
+    tilting test's failure angle when ``tilt`` is given, else the flank slope θ standing for it."""
     f = failure_numbers(ms)
     s = ms.sel(history=CLAIM_HISTORY)
     pos = [(float(q), float(s.major_by_position[j])) for j, q in enumerate(ms.position.values)
            if np.isfinite(s.major_by_position[j])]
-    theta = float(np.degrees(np.arctan(f["tan_flank"])))
+    theta = flank_slope(ms)
+    n = tilt_numbers(tilt) if tilt is not None and CLAIM_HISTORY in tilt.history.values else None
+    measured = n is not None and np.isfinite(n["theta_fail"])
+    phi = n["theta_fail"] if measured else theta
     close = f["share"] >= 0.9
-    return (f"On the point-source piles τ/σ_n on the surface-parallel planes is {f['mobilized']:.3f} on median "
-            f"against tan θ = {f['tan_flank']:.3f} of the fitted flanks: the ratio is {f['ratio']:.2f} "
-            f"({f['lo']:.2f} to {f['hi']:.2f}). It equals tan θ exactly when the force across the plane is vertical "
-            f"(a slab carrying its weight): the same statement as the first claim, read as a stress state. The most "
-            f"loaded plane of the same windows mobilizes tan φ = {f['tan_phi']:.3f} on median, so the "
-            f"surface-parallel plane carries {f['share']:.2f} of it: "
+    text = (f"On the point-source piles τ/σ_n on the surface-parallel planes is {f['mobilized']:.3f} on median; "
+            f"their flanks slope at θ = {theta:.1f}° on median (tan θ = {np.tan(np.radians(theta)):.3f}), and "
+            f"window by window τ/σ_n is {f['ratio']:.2f} tan θ on median ({f['lo']:.2f} to {f['hi']:.2f}). It "
+            f"equals tan θ exactly when the force across the plane is vertical (a slab carrying its weight): the "
+            f"same statement as the first claim, read as a stress state. The most loaded plane of the same windows "
+            f"mobilizes tan φ_σ = {f['tan_phi']:.3f} on median, so the surface-parallel plane carries {f['share']:.2f} "
+            f"of it: "
             + ("it is close to the most loaded plane, as in a bank at incipient failure, whose failure planes are "
-               "parallel to the surface. " if close else "it is not the most loaded plane. ")
-            + "The packing's macroscopic friction is not measured here (no shear test); the angle of repose θ stands "
-            f"for it, as in the Civil-Engineering reading. In a slope at that limit the major principal direction "
-            f"leans towards the axis by 45° − θ/2 = {45 - theta / 2:.1f}° from the vertical; measured (leaning "
-            f"outward positive), medians over the piles by position |x|/L: {_fmt_list(pos)}.")
+               "parallel to the surface. " if close else "it is not the most loaded plane. "))
+    if measured:
+        tan_phi = np.tan(np.radians(phi))
+        text += (f"The tilting test measures the grains' friction angle φ = {phi:.1f}° (tan φ = {tan_phi:.3f}): the "
+                 f"surface-parallel planes mobilize {f['mobilized'] / tan_phi:.2f} of it and the most loaded plane "
+                 f"{f['tan_phi'] / tan_phi:.2f}. ")
+    else:
+        text += ("The packing's macroscopic friction is not measured in this run (no tilting test); the angle of "
+                 "repose θ stands for it, as in the Civil-Engineering reading. ")
+    return text + (f"In a slope at that limit the major principal direction leans towards the axis by 45° − φ/2 = "
+                   f"{45 - phi / 2:.1f}° from the vertical; measured (leaning outward positive), medians over the "
+                   f"piles by position |x|/L: {_fmt_list(pos)}.")
+
+
+def tilt_text(tilt, ms=None):
+    """The tilting test: per flank the failure tilt, against the slope the pile was left at."""
+    if tilt is None or CLAIM_HISTORY not in tilt.history.values:
+        return "No tilting test in this run."
+    n = tilt_numbers(tilt)
+    t = tilt.attrs
+    lines = [f"Gravity is turned towards one flank by {n['step']:g}° at a time; each tilt is held at least "
+             f"{float(t['hold']):g} √(d/g) and then until every grain is back below the construction's rest speed "
+             f"(at most {float(t['max_hold']):g} √(d/g)), with the construction's time step and solver settings, "
+             f"warm-started from the history forces. A flank fails when {int(t['grains'])} grains of its side have "
+             f"moved more than {float(t['displaced_d']):g} d since the start. The {n['flanks']} flanks of the "
+             f"{n['piles']} point-source piles tilted (slope θ {n['theta']:.1f}° on median) fail after "
+             f"{n['margin']:.1f}° on median, single flanks from {n['alpha_min']:.1f}° to {n['alpha_max']:.1f}°: "
+             f"their failure angles θ + α_fail run from {n['theta_fail_lo']:.1f}° to {n['theta_fail_hi']:.1f}° "
+             f"({n['theta_fail']:.1f}° on median)."]
+    for name in tilt.pile.values[tilt.pile_history.values == "default"]:
+        d = tilt.sel(pile=name)
+        lines.append("The default pile: " + "; ".join(
+            f"{f} flank θ = {float(d.theta.sel(flank=f)):.1f}°, "
+            + (f"fails at α = {float(d.alpha_fail.sel(flank=f)):.1f}° (θ + α = {float(d.theta_fail.sel(flank=f)):.1f}°)"
+               if int(d.failed.sel(flank=f)) else f"no failure up to {n['max_deg']:g}°")
+            for f in d.flank.values) + ".")
+    near = int(np.sum(np.where(np.isfinite(tilt.alpha_fail.values[tilt.pile_history.values == CLAIM_HISTORY]),
+                               tilt.alpha_fail.values[tilt.pile_history.values == CLAIM_HISTORY], np.inf)
+                      <= n["threshold"]))
+    lines.append(f"{near} of the {n['flanks']} point-source flanks fail within {n['threshold']:g}° of their slope.")
+    return " ".join(lines)
 
 
 def three_d_text(ms):
     """Where the 2-D measurement speaks for Moreau's 3-D piles (conic and cylindric cuts) and where not."""
-    poured = [h for h in ("default", CLAIM_HISTORY) if h in ms.history.values]
-    sel = np.isin(ms.pile_history.values, poured)
-    theta = nan_stat(np.nanmedian, ms.surface_angle.values[sel])
+    theta = flank_slope(ms)
     return (
         "**Can.** The reciprocity formula is an identity of a symmetric tensor and holds in any dimension: with "
         "e_r the normal of a cylindric cut coaxial to the pile and n_s the normal of a conic cut parallel to the "
@@ -158,7 +200,8 @@ def three_d_text(ms):
         "**Cannot.** A 2-D pile of discs is a plane wedge: it has no hoop stress σ_θθ, which in an axisymmetric "
         "3-D pile enters the radial balance and changes how the weight is shared between the core and the bank; "
         "a cylindric cut near the axis encloses less material than a vertical cut through a wedge. The flanks of "
-        f"these disc piles slope at {theta:.1f}° on median; the angle of repose and the contact network of discs "
+        f"the point-source disc piles slope at {theta:.1f}° on median (over piles and flanks); the angle of repose "
+        "and the contact network of discs "
         "differ from those of spheres. The numbers of this page (the spread of the angles, "
         "the share of the available friction the bank mobilizes, the principal directions) are those of 2-D disc "
         "piles; only the identities (reciprocity, the weight of a column, the symmetry at equilibrium) carry over "

@@ -6,14 +6,16 @@ to the vertical against depth and position, medians over cuts and piles with boo
 bands over piles; (d) the exact ranges over A ∩ C; (e) both sides of the reciprocity
 formula per window, from the stress and from the cuts' own sums; (f) the friction
 mobilized on the surface-parallel planes against tan of the flank angle; (g) the major
-principal direction along the flank.
+principal direction along the flank; (h, i) the tilting test: each flank's failure angle
+against its slope, and the grains displaced against the tilt.
 """
 import numpy as np
 
 from ncd.figures.fig4_bank import stress as st
+from ncd.figures.fig4_bank.claims import CLAIM_HISTORY, flank_slope, tilt_numbers
 from ncd.figures.fig4_bank.measure import HISTORY_LABELS
 
-COLORS = {"default": "k", "point": "C3", "rain": "C0"}
+COLORS = {"default": "k", "point": "C3", "rain": "C0", "layer": "C2"}
 FONT = 11
 
 
@@ -153,52 +155,111 @@ def plot_failure(ax, ms):
     ax.set_ylabel(r"$\tau/\sigma_n$ on the surface-parallel plane", fontsize=FONT)
 
 
-def plot_principal(ax, ms):
+def limit_angle(ms, tilt=None):
+    """``(phi, measured)``: the tilting test's median failure angle of the point-source flanks, or
+    (no test) their median slope θ standing for it."""
+    if tilt is not None and CLAIM_HISTORY in tilt.history.values:
+        phi = tilt_numbers(tilt)["theta_fail"]
+        if np.isfinite(phi):
+            return phi, True
+    return flank_slope(ms), False
+
+
+def plot_principal(ax, ms, tilt=None):
     """(g) The major principal direction from the vertical along the flank (medians and bands), and
-    that of a slope at the limit, -(45° - theta/2), theta the point-source piles' median flank angle."""
+    that of a slope at the limit, -(45° - phi/2), phi the measured failure angle (else θ)."""
     ax.axhline(0.0, color="0.5", lw=0.6)
-    if "point" in _histories(ms):
-        theta = float(np.degrees(np.arctan(np.nanmedian(ms.tan_flank.values[ms.pile_history.values == "point"]))))
-        ax.axhline(-(45.0 - theta / 2), color=COLORS["point"], lw=0.8, ls="--")
-        ax.set_title(f"dashed: a slope at the limit, θ = {theta:.1f}°", fontsize=FONT - 1, loc="right",
-                     color=COLORS["point"])
+    if CLAIM_HISTORY in _histories(ms):
+        phi, measured = limit_angle(ms, tilt)
+        ax.axhline(-(45.0 - phi / 2), color=COLORS["point"], lw=0.8, ls="--")
+        ax.set_title(f"dashed: a slope at the limit, {'φ' if measured else 'θ'} = {phi:.1f}°", fontsize=FONT - 1,
+                     loc="right", color=COLORS["point"])
     _medians(ax, ms, "major", "position", "cut centre |x| / L", "major principal direction\nfrom the vertical "
              "(deg, + outward)")
 
 
-def figure(ms, exact, con):
-    """The figure of the page: (a) on top, (b)-(g) below."""
+def plot_tilt_angles(ax, tilt):
+    """(h) Each tilted flank's failure angle θ + α_fail against its slope θ: on the diagonal a flank
+    at incipient failure, the shaded band the claim's margin (tilt step + hysteresis)."""
+    n = tilt_numbers(tilt)
+    lo = float(np.nanmin(tilt.theta.values)) - 2.0
+    hi = max(float(np.nanmax(tilt.theta_fail.values)) if np.isfinite(tilt.theta_fail.values).any() else lo,
+             float(np.nanmax(tilt.theta.values))) + 2.0
+    xs = np.array([lo, hi])
+    ax.fill_between(xs, xs, xs + n["threshold"], color="0.9", lw=0)
+    ax.plot(xs, xs, "-", color="0.4", lw=0.6)
+    for h in [str(v) for v in tilt.history.values]:
+        sel = tilt.pile_history.values == h
+        for j, (f, mark) in enumerate(zip(tilt.flank.values, ("<", ">"))):
+            th, tf = tilt.theta.values[sel, j], tilt.theta_fail.values[sel, j]
+            ok = np.isfinite(tf)
+            ax.plot(th[ok], tf[ok], mark, color=COLORS[h], ms=6, label=f"{HISTORY_LABELS[h]}, {f} flank")
+            ax.plot(th[~ok], th[~ok] + n["max_deg"], "^", color=COLORS[h], ms=6, mfc="none")
+    ax.set(xlim=(lo, hi), ylim=(lo, hi + n["step"]))
+    ax.set_aspect("equal")
+    ax.set_xlabel("flank slope θ (deg)", fontsize=FONT)
+    ax.set_ylabel(r"failure angle $\theta + \alpha_\mathrm{fail}$ (deg)", fontsize=FONT)
+    ax.legend(fontsize=FONT - 1, loc="upper left", bbox_to_anchor=(2.45, 1.0), frameon=False)
+
+
+def plot_tilt_trajectories(ax, tilt):
+    """(i) Grains of the tilted side displaced by more than the threshold against the tilt, per
+    flank, up to its failure (the dotted line: the failure count)."""
+    al = tilt.alpha.values
+    for name, h in zip(tilt.pile.values, tilt.pile_history.values):
+        for f in tilt.flank.values:
+            y = tilt.displaced.sel(pile=name, flank=f).values
+            ax.plot(al, np.maximum(y, 0.5), "-", color=COLORS[str(h)], lw=1.2 if h == "default" else 0.7,
+                    alpha=1.0 if h == "default" else 0.6, drawstyle="steps-post")
+    ax.axhline(float(tilt.attrs["grains"]), color="0.4", lw=0.6, ls=":")
+    ax.set_yscale("log")
+    ax.set_xlim(0, float(np.nanmax(np.where(np.isfinite(tilt.alpha_fail.values), tilt.alpha_fail.values,
+                                            tilt.attrs["max_deg"]))) + 1.0)
+    ax.set_xlabel(r"tilt $\alpha$ towards the flank (deg)", fontsize=FONT)
+    ax.set_ylabel(f"grains moved > {float(tilt.attrs['displaced_d']):g} d", fontsize=FONT)
+
+
+def figure(ms, exact, con, tilt=None):
+    """The figure of the page: (a) on top, (b)-(g) below, (h, i) the tilting test when ``tilt`` is given."""
     import matplotlib.pyplot as plt
     from matplotlib.gridspec import GridSpec
-    fig = plt.figure(figsize=(13.5, 12.0))
-    gs = GridSpec(3, 3, figure=fig, height_ratios=[0.8, 1.0, 1.0], hspace=0.4, wspace=0.38,
-                  left=0.07, right=0.98, top=0.97, bottom=0.06)
+    rows = 3 if tilt is None else 4
+    fig = plt.figure(figsize=(13.5, 12.0 + 4.0 * (rows - 3)))
+    gs = GridSpec(rows, 3, figure=fig, height_ratios=[0.8] + [1.0] * (rows - 1), hspace=0.4, wspace=0.38,
+                  left=0.07, right=0.98, top=0.97, bottom=0.06 if tilt is None else 0.045)
     axa = fig.add_subplot(gs[0, :2])
     plot_flank(axa, ms, con, depth_index=min(1, ms.sizes["depth"] - 1))
-    axes = [axa] + [fig.add_subplot(gs[i, j]) for i, j in ((1, 0), (1, 1), (1, 2), (2, 0), (2, 1), (2, 2))]
+    cells = [(1, 0), (1, 1), (1, 2), (2, 0), (2, 1), (2, 2)] + ([] if tilt is None else [(3, 0), (3, 1)])
+    axes = [axa] + [fig.add_subplot(gs[i, j]) for i, j in cells]
     plot_angle(axes[1], ms, "depth")
     plot_angle(axes[2], ms, "position")
     plot_exact(axes[3], exact)
     plot_reciprocity(axes[4], ms)
     plot_failure(axes[5], ms)
-    plot_principal(axes[6], ms)
+    plot_principal(axes[6], ms, tilt)
+    if tilt is not None:
+        plot_tilt_angles(axes[7], tilt)
+        plot_tilt_trajectories(axes[8], tilt)
+    top = fig.transFigure.inverted().transform(axa.transAxes.transform((0.0, 1.0)))[1]
     handles, labels = axes[1].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="upper left", bbox_to_anchor=(0.69, 0.8), fontsize=FONT, frameon=False,
-               title="medians over cuts and piles,\nbars: bootstrap band over piles", title_fontsize=FONT)
+    fig.legend(handles, labels, loc="upper left", bbox_to_anchor=(0.69, top - 0.17 * 12.0 / fig.get_figheight()),
+               fontsize=FONT, frameon=False, title="medians over cuts and piles,\nbars: bootstrap band over piles",
+               title_fontsize=FONT)
     h5, l5 = axes[4].get_legend_handles_labels()
     axes[4].legend(h5[::-1], l5[::-1], fontsize=FONT - 1, loc="upper left", framealpha=0.9, edgecolor="none",
                    markerscale=3)
-    for ax, letter in zip(axes, "abcdefg"):
+    for ax, letter in zip(axes, "abcdefghi"):
         ax.tick_params(labelsize=FONT - 1)
         ax.text(-0.02, 1.03, f"({letter})", transform=ax.transAxes, fontsize=FONT + 1, fontweight="bold",
                 ha="right", va="bottom")
     return fig
 
 
-def caption(ms, depth_index=1):
+def caption(ms, depth_index=1, tilt=None):
     """The caption of :func:`figure` (the drawn window's depth and the claim's tolerance from the data)."""
     k = min(depth_index, ms.sizes["depth"] - 1)
-    return (f"**(a)** The right flank of the default pile: the surface-parallel cuts (orange) at each position and "
+    _, measured = limit_angle(ms, tilt)
+    text = (f"**(a)** The right flank of the default pile: the surface-parallel cuts (orange) at each position and "
             f"depth, the stress window of the cuts {float(ms.depth[k]):g} d deep (dashed) with the vertical cut "
             f"through its centre (blue), and the resultants across both cuts to one scale (red: across the "
             f"surface-parallel cut; blue: across the vertical cut). **(b, c)** Angle of the surface-parallel "
@@ -210,4 +271,13 @@ def caption(ms, depth_index=1):
             f"the mean pressure p: from the window's stress (coloured, on the diagonal) and from the cuts' own sums "
             f"(grey). **(f)** τ/σ_n on the surface-parallel plane against tan θ of the flank, per window (diamonds: "
             f"medians); the diagonal is a vertical force. **(g)** Major principal direction from the vertical along "
-            f"the flank; dashed: a slope at the limit of friction tan θ on its surface-parallel planes.")
+            f"the flank; dashed: a slope at the limit of friction on its surface-parallel planes, "
+            + ("φ the median failure angle of the tilting test." if measured else "θ standing for the friction angle."))
+    if tilt is not None:
+        n = tilt_numbers(tilt)
+        text += (f" **(h)** Tilting test: the failure angle θ + α_fail of each tilted flank against its slope θ "
+                 f"(◁ left, ▷ right; open triangles: no failure up to {n['max_deg']:g}°); on the diagonal a flank "
+                 f"at incipient failure, the grey band the claim's margin of {n['threshold']:g}°. **(i)** Grains of "
+                 f"the tilted side moved more than {float(tilt.attrs['displaced_d']):g} d against the tilt, per "
+                 f"flank up to its failure (dotted: {int(tilt.attrs['grains'])} grains, the failure).")
+    return text

@@ -40,6 +40,11 @@ def _default_cut(cuts):
     return kinds.index("default"), kinds
 
 
+def flank_name(cuts, k):
+    """The flank cut ``k`` lies on: its slope θ is that flank's fit, the one every page quotes."""
+    return "right" if int(cuts.outer.values[k]) > 0 else "left"
+
+
 def _rest_cloud(cuts, ens, k):
     rest = ens.outcome.values == REST       # converged at rest: motion solutions are another outcome
     return np.column_stack([ens.cut_force_x.values[rest, k], ens.cut_force_y.values[rest, k]])
@@ -52,7 +57,8 @@ def fig4_parallel(results):
     surf = float(cuts.surface_angle.values[k])
     tol = parallel_tol(surf)
     return judged(f"history resultant across the default cut {float(cuts.history_angle.values[k]):.1f}° below the "
-                  f"horizontal, {dev:+.1f}° from the free surface's slope ({surf:.1f}°; tolerance ±{tol:.1f}°)",
+                  f"horizontal, {dev:+.1f}° from the free surface's slope (its {flank_name(cuts, k)} flank's θ = {surf:.1f}°; "
+                  f"tolerance ±{tol:.1f}°)",
                   REPRODUCED if abs(dev) <= tol else DIFFERS,
                   "the history resultant across the default cut within 10° of the free surface and closer to it "
                   "than to the horizontal (|deviation| ≤ min(10°, slope/2); the horizontal is the direction "
@@ -315,7 +321,7 @@ def _exact_at_default(results):
     cuts, ens, ex = (open_data(results, f) for f in F4)
     k, _ = _default_cut(cuts)
     return cuts, ex, k, dict(
-        P=_rest_cloud(cuts, ens, k), surf=float(cuts.surface_angle.values[k]),
+        P=_rest_cloud(cuts, ens, k), surf=float(cuts.surface_angle.values[k]), flank=flank_name(cuts, k),
         lo=float(ex.angle_min.values[k]), hi=float(ex.angle_max.values[k]), fy_max=float(ex.fy_max.values[k]),
         arch=int(ex.all_arch.values.astype(bool).sum()), n=int(ex.sizes["cut"]))
 
@@ -337,7 +343,7 @@ def fig4_geometry_enough(results):
     far = f"; the history resultant lies {np.linalg.norm(hist - P.mean(0)):.3g} N from its mean" if len(P) else ""
     return judged(f"default cut: exact set of resultants {diameter(V):.3g} N across against a zero-guess cloud of "
                   f"{diameter(P):.3g} N{far}; over A ∩ C the resultant's angle ranges over [{e['lo']:.1f}°, "
-                  f"{e['hi']:.1f}°] below the horizontal (free surface {e['surf']:.1f}°, tolerance ±{tol:.1f}°); "
+                  f"{e['hi']:.1f}°] below the horizontal ({e['flank']} flank θ = {e['surf']:.1f}°, tolerance ±{tol:.1f}°); "
                   f"every admissible state arches at {e['arch']} of {e['n']} cuts", REPRODUCED if ok else DIFFERS,
                   "\"whatever is the indeterminacy\": every admissible resultant (A ∩ C) at the default cut "
                   "approximately parallel to the free surface, as in the row on the history resultant (within "
@@ -357,7 +363,7 @@ def fig4_reassuring(results):
                  f"({dev.min():+.1f}° to {dev.max():+.1f}° from the free surface), but ")
     ok = e["fy_max"] < 0
     return judged(f"{cloud}over A ∩ C the default cut's resultant ranges over [{e['lo']:.1f}°, {e['hi']:.1f}°] below the "
-                  f"horizontal ({e['hi'] - e['lo']:.1f}° wide; free surface {e['surf']:.1f}°): "
+                  f"horizontal ({e['hi'] - e['lo']:.1f}° wide; {e['flank']} flank θ = {e['surf']:.1f}°): "
                   + ("every admissible state arches there" if ok else
                      "it reaches the horizontal, the direction without arching")
                   + f"; every admissible state arches at {e['arch']} of {e['n']} cuts. The narrow cloud samples "
