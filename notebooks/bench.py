@@ -46,6 +46,9 @@
 #   `benchmark:` files;
 # * `dag.nc`: the CPU time of every job of the default run and the critical path of its
 #   DAG (the job graph of a dry run, the times of the benchmark files);
+# * `profile.nc`: the figures run again with the counts of `config/quick.yaml` under
+#   py-spy, every sample of every job filed under its figure and under numba kernels, LP
+#   solvers, other compiled code or Python (`ncd.studies.bench.profile`);
 # * `exact_sets.nc`: the LPs and LP time of the exact angle ranges of every history pile
 #   with an exact file (`ncd.studies.bench.solver.exact_costs`), the size study's included.
 
@@ -60,7 +63,8 @@ from ncd.studies.bench import page
 matplotlib.use("Agg")  # the figure is shown once, as the saved PNG
 
 # Snakemake's object, or by hand (from the repository or notebooks/) the files under results/
-NAMES = ["core", "sweeps", "tolerance", "tolerance_problems", "ensemble", "peer", "rules", "dag", "exact_sets"]
+NAMES = ["core", "sweeps", "tolerance", "tolerance_problems", "ensemble", "peer", "rules", "dag", "profile",
+         "exact_sets"]
 snakemake = paths("bench", NAMES, globals().get("snakemake"))
 data = {name: xr.load_dataset(getattr(snakemake.input, name)) for name in NAMES}
 core, sweeps, tol_ds, tol_pb = data["core"], data["sweeps"], data["tolerance"], data["tolerance_problems"]
@@ -191,6 +195,35 @@ display(Markdown(page.rules_sentence(data["rules"])))
 # %%
 per_fig, path, text = page.dag_tables(data["dag"])
 display(HTML(per_fig), HTML(path), Markdown(text))
+
+# %% [markdown]
+# ## Where the CPU goes: kernels, LP solvers, Python
+#
+# The figures' jobs run again, with the realization counts of `config/quick.yaml`, in a
+# scratch directory under `py-spy record --subprocesses --native` (`snakemake -j2
+# bench_profile`).  Each sample of each job's processes (its script, or its notebook's
+# nbconvert and kernel) is filed under the job's figure, read from the rules files, and
+# under the code it was in, read from its stack below the innermost Python frame: a numba
+# kernel (JIT code, which has no library), an LP solver (HiGHS, Clarabel, CLP), other compiled
+# code (numpy, scipy, BLAS, libc, numba's type dispatch), or the Python interpreter.  The
+# goal set for every figure: most of its CPU inside kernels and solvers, at least the
+# share `GOAL` of `ncd.studies.bench.profile` (the column's heading); a figure with fewer
+# than `MIN_SAMPLES` samples is not judged.  Job CPU and the seconds on the critical path
+# are those of the run of the previous section; the shares are those of the profiled run.
+# The last column is the sampled CPU over the jobs' wall time in the profiled run: below
+# one where a job waits (for the disk, for the other job on the cores) or where py-spy
+# attached to its process late.
+
+# %%
+profile = page.profile_frame(data["profile"], data["dag"])
+display(HTML(page.table(profile)), Markdown(page.profile_sentence(data["profile"])))
+
+# %% [markdown]
+# The innermost Python functions of each figure's samples outside kernels and solvers,
+# with their share of its samples: where its Python and other compiled time goes.
+
+# %%
+display(HTML(page.table(page.hot_spots_frame(data["profile"]))))
 
 # %% [markdown]
 # ## Exact sets of the history piles

@@ -160,6 +160,47 @@ def test_rules_and_dag_tables():
     assert "Critical path 70 s through 3 jobs" in text and path.count("<tr>") == 3      # one row per job of the path
 
 
+def small_profile():
+    """fig9: 800 kernel and 100 solver samples of 1000 (goal met); fig8: 300 kernel, 500 Python
+    (200 of them importing) and 200 numpy samples of 1000 (not met); the scheduler: 50."""
+    from ncd.studies.bench.profile import NOT_A_JOB
+    counts = {"fig9": {"kernel": 800, "solver": 100, "compiled": 0, "python": 100},
+              "fig8": {"kernel": 300, "solver": 0, "compiled": 200, "python": 500}, NOT_A_JOB: {"python": 50}}
+    labels = ["fig9", "fig8", NOT_A_JOB]
+    n = np.array([1000, 1000, 50])
+    share = {c: np.array([counts[f].get(c, 0) for f in labels]) / n for c in ("kernel", "solver", "compiled", "python")}
+    hot = np.array([["run (ncd/a.py)", "", ""], ["svd (numpy/linalg/_linalg.py)", "<module> (x.py)", ""],
+                    ["<module> (snakemake)", "", ""]])
+    return xr.Dataset({"samples": ("figure", n), **{f"{c}_share": ("figure", v) for c, v in share.items()},
+                       "sampled_cpu_s": ("figure", n / 25.0), "job_wall_s": ("figure", [50.0, 80.0, np.nan]),
+                       "import_share": ("figure", [0.0, 0.2, 0.0]), "numba_load_share": ("figure", [0.0, 0.05, 0.0]),
+                       "hot_function": (("figure", "rank"), hot),
+                       "hot_share": (("figure", "rank"), np.array([[0.1, 0, 0], [0.2, 0.1, 0], [1.0, 0, 0]]))},
+                      coords={"figure": labels, "rank": [1, 2, 3]},
+                      attrs={"rate": 25.0, "goal": 0.8, "min_samples": 200, "config_label": "quick",
+                             "pyspy_errors": 7})
+
+
+def test_profile_table_and_sentence():
+    """The goal column says met for the kernel-bound figure and not met for the one in Python;
+    job CPU and the critical path come from dag.nc, the shares from the profile."""
+    frame = BP.profile_frame(small_profile(), small_dag())
+    assert list(frame["goal (≥ 80 %)"]) == ["met", "not met", "—"]
+    np.testing.assert_allclose(frame["kernels + solvers (%)"], [90.0, 30.0, 0.0])
+    assert frame.loc["fig9", "job CPU (s)"] == 110.0 and frame.loc["fig9", "on the critical path (s)"] == 70.0
+    assert np.isnan(frame.loc["fig8", "job CPU (s)"]) and frame.loc["fig8", "on the critical path (s)"] == 0.0
+    np.testing.assert_allclose(frame["sampled CPU / job wall"].values[:2], [40.0 / 50.0, 40.0 / 80.0])
+    assert "<td>met</td>" in BP.table(frame)
+    text = BP.profile_sentence(small_profile())
+    assert "the quick counts, 25 samples per second, 2050 samples (py-spy could not read 7 stacks)" in text
+    assert "1 of 2 figures with at least 200 samples hold 80 % or more" in text
+    assert ("the furthest from it, fig8, holds 30 % there and spends 50 % in Python and 20 % in other compiled "
+            "code (imports 20 %, numba's dispatch and cache loading 5 %") in text
+    assert "Snakemake's own process: 2 s of CPU sampled." in text
+    hot = BP.hot_spots_frame(small_profile())
+    assert hot.loc["fig8", "1"] == "svd (numpy/linalg/_linalg.py) — 20 %" and hot.loc["fig9", "2"] == ""
+
+
 def small_exact(sizes=(1000, 10000)):
     """Two piles per history at 10^3 grains (LP seconds 2, 4 and 1, 3) and one at 10^4 (600, 300)."""
     rows = [(1000, "point", 2.0), (1000, "point", 4.0), (1000, "rain", 1.0), (1000, "rain", 3.0),

@@ -106,7 +106,7 @@ def test_extras_fit_their_use():
     workflow = requirements(EXTRAS["workflow"])
     assert {"snakemake", "jupytext", "nbconvert", "nbclient", "ipykernel", "matplotlib", "meshio",
             "pyevtk", "jupyter-server-mathjax"} <= workflow
-    assert requirements(EXTRAS["bench"]) == {"pymunk"}
+    assert requirements(EXTRAS["bench"]) == {"pymunk", "py-spy"}
     assert "snakemake-executor-plugin-slurm" in requirements(EXTRAS["cluster"])
     assert "workflow" in self_references(EXTRAS["cluster"])
     assert {"workflow", "bench"} <= self_references(EXTRAS["test"])

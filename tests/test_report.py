@@ -70,6 +70,9 @@ def test_every_claim_has_one_row_on_the_index(tmp_path):
     for c, fig, v in rows:
         assert v.verdict == (NOT_COMPUTED if fig else NOT_TESTED), (c["id"], v)
     assert "fig9_new" in page and "config digest" in page
+    # the size and realizations each figure ran at, and the run's label, beside its run time
+    page = build_page(tmp_path, ["fig4_pile"], {"run": {"label": "quick"}, "fig4_pile": {"ensemble": {"runs": 64}}})
+    assert "ensemble.runs = 64" in page and "this run (quick)" in page and "A quick run" in page
 
 
 def _sweep(tmp_path, fractions):

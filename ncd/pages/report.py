@@ -22,6 +22,8 @@ from ncd.io.netcdf import git_commit, versions
 from ncd.pages.claims import CLAIMS, criterion_of, criterion_texts, how_judged, sentence_verdict, verdicts
 from ncd.pages.registry import JUDGES_BY_FIGURE
 from ncd.pages.runscale import banner_html
+from ncd.pages.runscale import counts as counts_of
+from ncd.pages.runscale import label as run_label
 from ncd.shared.verdict import BEYOND, CONSISTENT, DIFFERS, NOT_COMPUTED, NOT_TESTED, REPRODUCED
 
 UNGER = "unger2005"      # the source of the findings judged beyond the paper (Unger, Kertész & Wolf 2005)
@@ -205,8 +207,9 @@ def build_page(results, figures, config, claims=CLAIMS):
         jobs, secs = run_times(results, fig)
         total += secs
         n_claims = sum(any(f == fig for f, _ in evidence) for _, evidence, _, _ in sentences)
-        figs.append(f"<tr><td><a href='html/{fig}.html'>{e(fig)}</a></td><td>{n_claims}</td><td>{jobs}</td>"
-                    f"<td>{secs:.1f}</td><td>{thumb(fig)}</td></tr>")
+        scale = "<br>".join(f"{e(k.split('.', 1)[1])} = {v}" for k, v in counts_of(config, fig)) or "—"
+        figs.append(f"<tr><td><a href='html/{fig}.html'>{e(fig)}</a></td><td class='small'>{scale}</td>"
+                    f"<td>{n_claims}</td><td>{jobs}</td><td>{secs:.1f}</td><td>{thumb(fig)}</td></tr>")
     prov = "".join(f"<tr><th>{e(k)}</th><td><code>{e(str(v))}</code></td></tr>" for k, v in provenance_rows(config))
     counts = tally(sentences)
     summary = ", ".join(f"{n} {v}" for v, n in counts.items() if n)
@@ -231,7 +234,8 @@ evidence, the row shows each page's number and one verdict by the stated rule.</
 <h2>Figures and run time</h2>
 <p class="small">Run time: the sum of the wall times of the figure's jobs
 (<code>results/benchmarks/&lt;figure&gt;/*.tsv</code>), {total:.0f} s in all; with <code>-j2</code> two jobs run at once.</p>
-<table><tr><th>figure</th><th>claims</th><th>jobs</th><th>s</th><th></th></tr>{''.join(figs)}</table>
+<table><tr><th>figure</th><th>size and realizations of this run ({e(run_label(config))})</th><th>claims</th>
+<th>jobs</th><th>s</th><th></th></tr>{''.join(figs)}</table>
 <h2>Provenance</h2><table>{prov}</table>
 </body></html>
 """

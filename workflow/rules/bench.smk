@@ -10,6 +10,9 @@
 #   rules     wall time of every rule of the figures' run       -> results/bench/rules.nc
 #   dag       CPU seconds of every job of the default run and the
 #             critical path of its DAG                          -> results/bench/dag.nc
+#   profile   the figures run again with config/quick.yaml's counts in a scratch directory
+#             under py-spy: each figure's share of CPU in numba kernels, LP solvers,
+#             other compiled code and Python                    -> results/bench/profile.nc
 #   notebook  notebooks/bench.ipynb                             -> results/figures/bench.png|pdf
 # Every timing rule asks for all the cores (threads: BENCH_THREADS), so that with -j2
 # Snakemake runs it alone: no other job competes with what it measures.
@@ -175,6 +178,35 @@ rule bench_dag:
         "../scripts/bench_dag.py"
 
 
+rule bench_profile:
+    """Where the figures' CPU goes: the figures' jobs run again (config/quick.yaml's counts,
+    as caps over this run's config) in a scratch working directory under
+    ``py-spy record --subprocesses --native``, every sample filed under its job's figure
+    (read from the rules files) and its category (ncd.studies.bench.profile).  The run is
+    of the real jobs, with the numba cache of this checkout, as a run here would be."""
+    input:
+        code=code_of("bench_profile"),
+    output:
+        "results/bench/profile.nc",
+    threads: BENCH_THREADS
+    params:
+        root=str(REL),
+        overlay="config/quick.yaml",
+        targets=CFGB.get("profile", {}).get("figures", FIGURES),
+        figures=FIGURES,
+        cores=BENCH_THREADS,
+        rate=CFGB.get("profile", {}).get("rate", 25),
+    log:
+        log(FIGB, "profile"),
+        run=log(FIGB, "profile_run"),
+    benchmark:
+        bench(FIGB, "profile")
+    conda:
+        CONDA_ENV
+    script:
+        "../scripts/bench_profile.py"
+
+
 rule bench_notebook:
     input:
         core="results/bench/core.nc",
@@ -185,6 +217,7 @@ rule bench_notebook:
         peer="results/bench/peer.nc",
         rules="results/bench/rules.nc",
         dag="results/bench/dag.nc",
+        profile="results/bench/profile.nc",
         exact_sets="results/bench/exact_sets.nc",
         notebook=notebook_file("bench"),
         notebook_py=notebook_file("bench", "py"),

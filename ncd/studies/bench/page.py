@@ -1,7 +1,7 @@
 """The speed report page: its figure, its tables and its sentences, from ``results/bench/*.nc``.
 
 Every function takes the loaded Datasets of the bench rules (``core``, ``sweeps``,
-``tolerance``, ``tolerance_problems``, ``ensemble``, ``peer``, ``rules``, ``dag``) and
+``tolerance``, ``tolerance_problems``, ``ensemble``, ``peer``, ``rules``, ``dag``, ``profile``) and
 returns what the page shows: HTML tables with formatted numbers, Markdown sentences whose
 numbers come from the data, and the 2x2 figure (:func:`plot`).
 """
@@ -9,6 +9,7 @@ import numpy as np
 import pandas as pd
 import yaml
 
+from ncd.studies.bench.profile import NOT_A_JOB, goal_status
 from ncd.studies.bench.runs import dag_summary
 from ncd.studies.bench.solver import scaling_table
 
@@ -223,6 +224,66 @@ def dag_tables(dag):
     """CPU and wall seconds per figure and the critical path (HTML), and the sentence."""
     per_fig, path, text = dag_summary(dag)
     return table(per_fig, digits=4), table(path, digits=4, index=False), text
+
+
+def profile_frame(profile, dag=None):
+    """Per figure of ``profile.nc`` (:mod:`ncd.studies.bench.profile`): its job CPU (core
+    seconds) and its jobs' seconds on the critical path in the run of ``dag.nc`` (when
+    given), then from the profiled run the samples, the share (%) of each category, kernels
+    and solvers together, the goal's status (:func:`~ncd.studies.bench.profile.goal_status`)
+    and the sampled CPU over the jobs' wall time (how much of the jobs' time the samples saw)."""
+    df = pd.DataFrame(index=pd.Index(profile.figure.values.astype(str), name="figure"))
+    if dag is not None:
+        jobs = dag.to_dataframe()
+        df["job CPU (s)"] = jobs.groupby("figure").cpu_s.sum().reindex(df.index)
+        df["on the critical path (s)"] = jobs[jobs.critical == 1].groupby("figure").alone_s.sum() \
+            .reindex(df.index).fillna(0.0)
+        df.loc[df.index == NOT_A_JOB, "on the critical path (s)"] = np.nan
+    df["samples"] = profile.samples.values
+    for name, var in (("kernels", "kernel_share"), ("LP solvers", "solver_share"),
+                      ("other compiled", "compiled_share"), ("Python", "python_share")):
+        df[f"{name} (%)"] = 100 * profile[var].values
+    df["kernels + solvers (%)"] = df["kernels (%)"] + df["LP solvers (%)"]
+    df[f"goal (≥ {100 * float(profile.attrs['goal']):.0f} %)"] = goal_status(profile)
+    if "job_wall_s" in profile:
+        df["sampled CPU / job wall"] = profile.sampled_cpu_s.values / profile.job_wall_s.values
+    return df
+
+
+def hot_spots_frame(profile, top=3):
+    """Per figure, its ``top`` innermost Python functions outside kernels and solvers, each
+    with its share (%) of the figure's samples: where its Python and other compiled time is
+    spent."""
+    rows = {}
+    for k, fig in enumerate(profile.figure.values.astype(str)):
+        names, shares = profile.hot_function.values[k], profile.hot_share.values[k]
+        rows[fig] = [f"{n} — {100 * x:.0f} %" if n else "" for n, x in zip(names[:top], shares[:top])]
+    return pd.DataFrame.from_dict(rows, orient="index", columns=[str(r) for r in range(1, top + 1)]) \
+        .rename_axis("figure")
+
+
+def profile_sentence(profile):
+    """The profiled run, the figures meeting the goal, and where the figure furthest from it
+    spends the rest (Python, other compiled code, imports, numba's dispatch and cache loading)."""
+    a = profile.attrs
+    status = dict(zip(profile.figure.values.astype(str), goal_status(profile)))
+    judged = [f for f, s in status.items() if s in ("met", "not met")]
+    met = [f for f in judged if status[f] == "met"]
+    inside = dict(zip(profile.figure.values.astype(str), (profile.kernel_share + profile.solver_share).values))
+    text = (f"Profiled run: the {a.get('config_label', 'full')} counts, {float(a['rate']):g} samples per second, "
+            f"{int(profile.samples.sum())} samples (py-spy could not read {int(a.get('pyspy_errors', 0))} stacks).  "
+            f"{len(met)} of {len(judged)} figures with at least {int(a['min_samples'])} samples hold "
+            f"{100 * float(a['goal']):.0f} % or more of their CPU inside kernels and LP solvers")
+    if judged:
+        worst = min(judged, key=inside.get)
+        w = profile.sel(figure=worst)
+        text += (f"; the furthest from it, {worst}, holds {100 * inside[worst]:.0f} % there and spends "
+                 f"{100 * float(w.python_share):.0f} % in Python and {100 * float(w.compiled_share):.0f} % in other "
+                 f"compiled code (imports {100 * float(w.import_share):.0f} %, numba's dispatch and cache loading "
+                 f"{100 * float(w.numba_load_share):.0f} %, across categories)")
+    if NOT_A_JOB in status:
+        text += f".  Snakemake's own process: {float(profile.sampled_cpu_s.sel(figure=NOT_A_JOB)):.0f} s of CPU sampled"
+    return text + "."
 
 
 def exact_frame(costs):
