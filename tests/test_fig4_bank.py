@@ -224,7 +224,7 @@ def test_data_labelled_and_complete(data):
     assert missing_metadata(ms) == []
     for e in exact.values():
         assert missing_metadata(e) == []
-    assert set(ms.pile_history.values) == {"default", "point", "rain"}
+    assert set(ms.pile_history.values) == {"default", "point", "rain", "layer"}
     assert ms.valid.sum() > 0
     assert "default" in exact and any(k.startswith("point_") for k in exact) and any(k.startswith("rain_") for k in exact)
 

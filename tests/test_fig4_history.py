@@ -151,6 +151,10 @@ def test_sieve_rain_follows_the_heap():
     assert src.half_width < 25 * d
     p, r = src.draw(pos, rad, 50)
     assert len(r) > 0 and np.all(np.abs(p[:, 0]) <= src.half_width)
+    # each grain falls from drop_height_d above the settled surface under it (a flat row here),
+    # not from above the apex
+    lift = (cfg["rain"]["drop_height_d"] + 0.5) * d
+    np.testing.assert_allclose(p[:, 1], d + lift, rtol=0, atol=1e-12)
     src.update_height(pos[:5], rad[:5], still[:5], ok[:5])   # fewer grains: the sieve keeps its width
     assert src.half_width == pytest.approx(cfg["rain"]["footprint_fraction"] * reach)
     bad = {**cfg, "rain": {**cfg["rain"], "footprint_fraction": 1.5}}
@@ -342,8 +346,9 @@ def check_exact_ranges(analysis, certified=1.0):
     """Every exact range computed and holding the history angle; at least the fraction
     ``certified`` of them certified to CERTIFIED_DEG (every one by the simplex route)."""
     cfg = yaml.safe_load(analysis.attrs["config_yaml"])
-    done = analysis.exact_computed.values
+    done = analysis.exact_computed.sel(history=["point", "rain"]).values     # the layer has none
     assert done.sum() == 2 * min(cfg["exact"]["piles"], cfg["piles"]) and done[:, 0].all()
+    assert int(analysis.exact_computed.sel(history="layer").sum()) == 0
     e = analysis.where(analysis.exact_computed == 1, drop=True)
     lo, hi, dev = e.exact_deviation_min.values, e.exact_deviation_max.values, e.cut_deviation.values
     ok = np.isfinite(lo)
@@ -364,7 +369,7 @@ def check_exact_ranges(analysis, certified=1.0):
 def test_bands_are_over_piles(analysis, piles, results):
     cfg = yaml.safe_load(analysis.attrs["config_yaml"])
     n = cfg["piles"]
-    assert analysis.sizes["pile"] == n and len(piles) == 2 * n
+    assert analysis.sizes["pile"] == n and len(piles) == 3 * n
     # the mean profile is the mean of the per-pile profiles, and the band is the bootstrap over piles
     np.testing.assert_allclose(analysis.profile_mean, analysis.profile.mean("pile"), rtol=1e-12)
     rng = np.random.default_rng(cfg["analysis"]["seed"])
@@ -449,6 +454,22 @@ def test_size_study_compares_every_size(size, results):
     assert np.isnan(p[0]).all() and np.all((p[1:] > 0) & (p[1:] <= 1))
 
 
+def test_size_study_states_the_shape_match_at_every_size(size, results):
+    """size.nc carries, per size, the rain's shape difference from the point source as the
+    analysis of that size computes it, and the page says matched or not against the tolerance."""
+    from ncd.figures.fig4_history import size_plots
+
+    text = size_plots.shape_text(size)
+    for z, n in enumerate(_sizes(results)):
+        an = xr.load_dataset(results / "fig4_history" / f"analysis_n{n}.nc")
+        m = ha.comparison_summary(an, "rain")
+        np.testing.assert_allclose(size.shape_rel.values[z], [m["shape"][k]["rel"] for k in size.shape.values],
+                                   rtol=0, atol=1e-12)
+        word = "matches" if m["matched"] else "does not match"
+        assert f"{int(size.grains.values[z])} grains ({int(size.piles.values[z])} piles per history): the rain's " \
+               f"mean heap {word}" in text
+
+
 def test_the_largest_piles_exact_ranges_by_interior_point_hold_the_history_angle(size, results):
     """The size overlay's exact ranges come from Clarabel's interior point (as
     config/large.yaml's): the same checks as the default piles' HiGHS ranges."""
@@ -471,6 +492,9 @@ def test_size_study_states_each_sizes_exact_ranges(size, results):
         cfg = yaml.safe_load(an.attrs["config_yaml"])
         for i, h in enumerate(size.history.values):
             x = size.isel(size=z, history=i)
+            if h == "layer":                 # the layer is the control shape: no exact ranges
+                assert int(x.exact_piles) == 0
+                continue
             piles = min(cfg["exact"]["piles"], cfg["piles"])
             assert int(x.exact_piles) == piles
             e = an.sel(history=h).isel(pile=slice(0, piles))
@@ -496,7 +520,8 @@ def test_size_study_without_exact_ranges_says_so(analysis):
     bare = analysis.drop_vars([v for v in analysis.data_vars if v.startswith("exact_")])
     sz = hsz.size_dataset([analysis, bare.assign(n_grains=bare.n_grains * 10)])
     assert np.all(sz.exact_piles.values[1] == 0) and np.isnan(sz.exact_width_median.values[1]).all()
-    assert np.all(sz.exact_piles.values[0] > 0)
+    assert np.all(sz.exact_piles.sel(history=["point", "rain"]).values[0] > 0)
+    assert np.all(sz.exact_piles.sel(history="layer").values == 0)
     n = int(sz.grains.values[1])
     assert f"{n} grains, point: no exact ranges computed." in size_plots.exact_text(sz)
 
@@ -530,7 +555,7 @@ def test_page_figure_and_sentences(analysis, piles, results):
 
     first = {ds.attrs["history"]: ds for ds in piles if ds.attrs["member"] == 0}
     fig = hp.figure(analysis, [first["point"], first["rain"], first["layer"]])
-    assert [ax.get_title(loc="left")[:3] for ax in fig.axes] == ["(a)", "(b)", "(c)", "(d)"]
+    assert [ax.get_title(loc="left")[:3] for ax in fig.axes] == ["(a)", "(b)", "(c)", "(d)", "(e)"]
     lay = text_layout(fig)
     assert lay["overlaps"] == [] and lay["min_font_pt"] >= MIN_FONT_PT
     plt.close(fig)

@@ -34,6 +34,7 @@ class _Source:
         self.taken = 0                      # grains already inserted from ``radii``
         self.half_span = half_span          # settled grains within this |x| (plus d) set the height
         self.speed = s["inlet_speed"] * np.sqrt(cfg["gravity"] * self.d)
+        self.y_ground = y_ground
         self.height = y_ground + (s["drop_height_d"] + 0.5) * self.d
         self.settle_speed = 0.2 * np.sqrt(cfg["gravity"] * self.d)
 
@@ -165,6 +166,7 @@ class SieveRain(_Source):
         self.min_half = 0.5 * cfg["source"]["slots"] * 2.2 * g["radius_max"]
         super().__init__(cfg, rng, y_ground, self.min_half, radii)
         self.fraction, self.sites, self.trim = float(r["footprint_fraction"]), int(r["sites"]), int(r["trim"])
+        self.drop_d = float(r["drop_height_d"])
         if not 0.0 < self.fraction <= 1.0:
             raise ValueError(f"rain.footprint_fraction = {self.fraction!r} must lie in (0, 1]")
         self.half_width = self.min_half
@@ -173,6 +175,7 @@ class SieveRain(_Source):
         """Widen the sieve to ``fraction`` of the settled heap's footprint (it never
         narrows), then raise it above the settled grains under it."""
         settled = age_ok & (np.hypot(vel[:, 0], vel[:, 1]) < self.settle_speed)
+        self.settled = settled          # the surface under each site (draw): settled grains only
         if settled.sum() > self.trim:
             reach = np.sort(np.abs(pos[settled, 0]) + radius[settled])[-1 - self.trim]
             self.half_width = max(self.half_width, self.min_half, self.fraction * float(reach))
@@ -187,10 +190,22 @@ class SieveRain(_Source):
         self.half_width = self.half_span = float(state.get("half_width", self.min_half))
 
     def draw(self, pos, radius, limit):
+        """New grains under the sieve, each dropped from ``rain.drop_height_d`` mean diameters
+        above the heap's surface where it falls (the top of the settled grains within one
+        diameter of its abscissa, as :meth:`update_height` found them; the ground where there
+        are none): the impact speed is then the same at every size of heap, where a sieve
+        above the apex would hit the lower flanks ever harder as the heap grows.  Every grain
+        is checked for clearance against every grain, falling ones included (a low site lies
+        far below the apex, where no height cut applies)."""
         new_p, new_r = [], []
-        pos, radius = self._near(pos, radius)
+        lift = (self.drop_d + 0.5) * self.d
+        settled = getattr(self, "settled", None)
+        if settled is None or len(settled) != len(radius):
+            settled = np.zeros(len(radius), bool)
         for x in self.rng.uniform(-self.half_width, self.half_width, self.sites):
             if len(new_r) >= limit:
                 break
-            self._try(x, self._radius(), pos, radius, new_p, new_r)
+            under = settled & (np.abs(pos[:, 0] - x) < self.d)
+            top = float(np.max(pos[under, 1] + radius[under])) if under.any() else self.y_ground
+            self._try(x, self._radius(), pos, radius, new_p, new_r, max(top, self.y_ground) + lift - self.height)
         return np.array(new_p).reshape(-1, 2), np.array(new_r)

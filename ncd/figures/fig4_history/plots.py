@@ -123,12 +123,12 @@ def plot_shapes(ax, an):
                     color=COLORS["rain"] if c == "rain" else "0.4", label=COMPARISON_LABELS[c])
     if "comparison" in an.dims and "layer" in an.comparison.values:
         rel = 100 * an.cmp_shape_rel.sel(comparison="layer").values
-        ax.text(0.02, 0.03, "layer − point: " + ", ".join(f"{v:+.0f} %" for v in rel), transform=ax.transAxes,
-                fontsize=9, color=COLORS["layer"])
+        ax.text(0.02, 0.98, "layer − point: " + ", ".join(f"{v:+.0f} %" for v in rel), transform=ax.transAxes,
+                va="top", fontsize=9, color=COLORS["layer"])
     ax.axhline(0, color="0.5", lw=0.6)
     ax.set_xticks(range(len(SHAPES)), [SHAPE_LABELS[m].replace(" ", "\n", 1) for m in SHAPES])
     ax.set_ylabel("difference of the mean piles (%)")
-    ax.legend(fontsize=9, loc="upper right", frameon=False)
+    ax.legend(fontsize=9, loc="lower right", frameon=False)
     ax.set_title(f"(b) shape match (strip: ±{100 * tol:g} %)", fontsize=10, loc="left")
 
 
@@ -269,7 +269,9 @@ distance of the flank fits; cone ratio apex / (half-width × tan flank), 1 for a
                           for k, v in m["shape"].items())
         text += f"""
 The rain falls through a sieve that spans {100 * cfg['rain']['footprint_fraction']:g} % of the footprint of the heap as
-it grows, so its grains land on the heap and the heap grows at its angle of repose. Its mean
+it grows, each grain from {cfg['rain']['drop_height_d']:g} d above the settled surface where it lands (a height
+chosen on these piles to match the flank slope; `docs/history.md`), so its grains land on the heap and the heap
+grows at its angle of repose. Its mean
 heap differs from the point source's by {diffs} ({100 * an.attrs['level']:g} % basic bootstrap
 bands over piles). Criterion, stated before the
 data: the shapes **match** when each relative difference of the means lies within
