@@ -15,6 +15,7 @@ COUNTS = {
     "fig3_equilibrium": (("modes", "zero", "runs"), ("modes", "random", "runs"), ("modes", "warm", "runs")),
     "fig4_pile": (("ensemble", "runs"), ("tolerance_study", "runs"), ("warm_ensemble", "runs")),
     "fig4_history": (("piles",), ("exact", "piles"), ("grains", "n")),
+    "fig4_bank": (("tilt", "piles"),),
     "fig5_governing": (("packings", "n_discs"), ("packings", "per_mu"), ("packings", "control"),
                        ("walk", "samples"), ("uniform", "per_chain"), ("flows", "seeds")),
 }
