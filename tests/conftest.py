@@ -21,7 +21,7 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ[_var] = "1"
 
 ROOT = Path(__file__).resolve().parent.parent
-WORKFLOW_FILES = ("Snakefile", "config.yaml", "profiles", "workflow", "notebooks", "ncd",
+WORKFLOW_FILES = ("Snakefile", "config.yaml", "config/quick.yaml", "profiles", "workflow", "notebooks", "ncd",
                   "tests/config_reduced.yaml", "tests/config_reduced_size.yaml")
 
 

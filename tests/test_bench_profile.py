@@ -314,8 +314,8 @@ def test_profile_file_of_the_run(results):
     np.testing.assert_allclose(sum(ds[f"{c}_share"] for c in P.CATEGORIES).values, 1.0)
     known = {r.figure for r in P.rules_table(RULES).values()} - {"{figure}"} | {P.NOT_A_JOB}
     assert set(ds.figure.values.astype(str)) <= known
-    assert {"fig1_wedged", "fig2_slope"} <= set(ds.figure.values.astype(str))
-    assert ds.attrs["command"].startswith("py-spy record --subprocesses --native")
+    assert "fig1_wedged" in set(ds.figure.values.astype(str))     # every config profiles it (the test run: it alone)
+    assert "py-spy record --subprocesses --native" in ds.attrs["command"]
     assert ds.attrs["config_label"] == "quick" and ds.attrs["rate"] > 0
     assert not any("date" in k or "time" in k for k in ds.attrs)
     assert (ds.samples >= 0).all() and int(ds.samples.sum()) <= ds.attrs["pyspy_samples"]

@@ -185,6 +185,7 @@ rule bench_profile:
     (read from the rules files) and its category (ncd.studies.bench.profile).  The run is
     of the real jobs, with the numba cache of this checkout, as a run here would be."""
     input:
+        overlay="config/quick.yaml",     # the counts of the profiled run (caps over this run's config)
         code=code_of("bench_profile"),
     output:
         "results/bench/profile.nc",
