@@ -113,7 +113,13 @@ display(Markdown(hp.stress_text(an)))
 display(Markdown(claim_markdown("s5-dip", results, JUDGES)))
 
 # %%
-display(Markdown(hp.experiments_text(an) + "\n\n" + hp.arching_text(an)))
+display(Markdown(hp.experiments_text(an)))
+
+# %%
+display(Markdown(claim_markdown("history-dip-contrast", results, JUDGES)))
+
+# %%
+display(Markdown(hp.arching_text(an)))
 
 # %%
 display(Markdown(claim_markdown("s5-parallel-to-surface", results, JUDGES)))
