@@ -149,4 +149,5 @@ def size_dataset(analyses, seed=16):
     out[Z].attrs.update(units="1", long_name="size index (grain counts ascending)")
     out[Kd].attrs.update(units="1", long_name="kernel standard deviation in mean grain diameters")
     out[Q].attrs.update(units="1", long_name="cut position |x| / base half-width")
+    out["shape"].attrs.update(long_name="shape measure: flank slope (degree), apex height (d), base half-width (d)")
     return out
