@@ -170,12 +170,13 @@ class SieveRain(_Source):
         if not 0.0 < self.fraction <= 1.0:
             raise ValueError(f"rain.footprint_fraction = {self.fraction!r} must lie in (0, 1]")
         self.half_width = self.min_half
+        self.settled = np.zeros(0, bool)      # the settled grains at the last update_height (draw's surface)
 
     def update_height(self, pos, radius, vel, age_ok):
         """Widen the sieve to ``fraction`` of the settled heap's footprint (it never
         narrows), then raise it above the settled grains under it."""
         settled = age_ok & (np.hypot(vel[:, 0], vel[:, 1]) < self.settle_speed)
-        self.settled = settled          # the surface under each site (draw): settled grains only
+        self.settled = settled
         if settled.sum() > self.trim:
             reach = np.sort(np.abs(pos[settled, 0]) + radius[settled])[-1 - self.trim]
             self.half_width = max(self.half_width, self.min_half, self.fraction * float(reach))
@@ -199,9 +200,7 @@ class SieveRain(_Source):
         far below the apex, where no height cut applies)."""
         new_p, new_r = [], []
         lift = (self.drop_d + 0.5) * self.d
-        settled = getattr(self, "settled", None)
-        if settled is None or len(settled) != len(radius):
-            settled = np.zeros(len(radius), bool)
+        settled = self.settled if len(self.settled) == len(radius) else np.zeros(len(radius), bool)
         for x in self.rng.uniform(-self.half_width, self.half_width, self.sites):
             if len(new_r) >= limit:
                 break

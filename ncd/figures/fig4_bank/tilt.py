@@ -197,8 +197,8 @@ def tilt_dataset(cfg, piles):
     hist = np.array([p[1] for p in piles])
     histories = [h for h in HISTORY_LABELS if h in hist]
     theta = np.array([p[3]["theta"] for p in piles])
-    fail = np.array([[f["alpha_fail"] for f in p[3]["flanks"]] for p in piles])
-    per_level = lambda k: np.array([[f[k] for f in p[3]["flanks"]] for p in piles])  # noqa: E731
+    per_flank = lambda k: np.array([[f[k] for f in p[3]["flanks"]] for p in piles])  # noqa: E731
+    fail = per_flank("alpha_fail")
     data = {
         "pile_history": ((P,), hist, {"long_name": "construction history of the pile (default: fig4_pile)"}),
         "source_file": ((P,), np.array([str(p[2]) for p in piles]), {"long_name": "the pile's file, relative to the "
@@ -210,20 +210,20 @@ def tilt_dataset(cfg, piles):
                                               "theta + alpha_fail: the measured friction angle phi"}),
         "failed": ((P, F), np.isfinite(fail).astype(np.int8), {"units": "1", "long_name": "the flank failed "
                                                               "within max_deg"}),
-        "steps": ((P, F), np.array([[f["steps"] for f in p[3]["flanks"]] for p in piles]),
+        "steps": ((P, F), per_flank("steps"),
                   {"units": "1", "long_name": "Moreau-Jean steps of the test"}),
         "n_grains": ((P,), np.array([p[3]["n_grains"] for p in piles]), {"units": "1", "long_name": "grains"}),
-        "displaced": ((P, F, A), per_level("displaced"), {"units": "1", "long_name": "grains of the tilted side "
+        "displaced": ((P, F, A), per_flank("displaced"), {"units": "1", "long_name": "grains of the tilted side "
                       "displaced by more than displaced_d d since the start, at the end of the level"}),
-        "max_displacement": ((P, F, A), per_level("max_displacement"), {"units": "1", "long_name": "largest "
+        "max_displacement": ((P, F, A), per_flank("max_displacement"), {"units": "1", "long_name": "largest "
                              "displacement of a grain of the tilted side since the start, mean diameters"}),
-        "kinetic_energy": ((P, F, A), per_level("ke_end"), {"units": "J m-1", "long_name": "kinetic energy at the "
+        "kinetic_energy": ((P, F, A), per_flank("ke_end"), {"units": "J m-1", "long_name": "kinetic energy at the "
                            "end of the level (per unit depth)"}),
-        "kinetic_energy_max": ((P, F, A), per_level("ke_max"), {"units": "J m-1", "long_name": "largest kinetic "
+        "kinetic_energy_max": ((P, F, A), per_flank("ke_max"), {"units": "J m-1", "long_name": "largest kinetic "
                                "energy during the level"}),
-        "sweeps": ((P, F, A), per_level("sweeps"), {"units": "1", "long_name": "NLGS sweeps per step, mean over "
+        "sweeps": ((P, F, A), per_flank("sweeps"), {"units": "1", "long_name": "NLGS sweeps per step, mean over "
                    "the level"}),
-        "held": ((P, F, A), per_level("held"), {"units": "1", "long_name": "time the level was held (until back at "
+        "held": ((P, F, A), per_flank("held"), {"units": "1", "long_name": "time the level was held (until back at "
                  "rest, or failure), in sqrt(d/g)"}),
     }
     band = np.full((len(histories), 3), np.nan)

@@ -140,11 +140,13 @@ def exact_arrays(exact, hist, n, shape):
     return lo, hi, out, done, confirmed
 
 
-# name: (group A, group B, role); a group is (history, members): None all, "even"/"odd" a half
+# name: (group A, group B, role, expected); a group is (history, members): None all, "even"/"odd" a half;
+# expected: a control's required outcome (True: the groups must differ), None for the test itself
 COMPARISONS = {
-    "rain": (("point", None), ("rain", None), "test: point source against the rain that builds the same heap"),
-    "layer": (("point", None), ("layer", None), "control: a difference known to exist (heap against layer)"),
-    "same": (("point", "even"), ("point", "odd"), "control: one history, different seeds (even against odd members)"),
+    "rain": (("point", None), ("rain", None), "test: point source against the rain that builds the same heap", None),
+    "layer": (("point", None), ("layer", None), "control: a difference known to exist (heap against layer)", True),
+    "same": (("point", "even"), ("point", "odd"), "control: one history, different seeds (even against odd members)",
+             False),
 }
 
 
@@ -163,7 +165,7 @@ def comparisons(cfg, an, hist, rng):
     dip_fn = lambda prof: dip_depth(prof, xi, a["dip_center"], a["dip_flank"])  # noqa: E731
     names, rows = [], []
     n = an.sizes["pile"]
-    for name, (ga, gb, _) in COMPARISONS.items():
+    for name, (ga, gb, _, _) in COMPARISONS.items():
         if ga[0] not in hist or gb[0] not in hist:
             continue
         groups = []
@@ -340,15 +342,27 @@ def comparison_summary(an, name, kernel=None):
     sk = s.sel(kernel=k)
     rel, rlo, rhi = s.cmp_shape_rel.values, s.cmp_shape_rel_lo.values, s.cmp_shape_rel_hi.values
     tol = float(an.attrs.get("shape_tol", cmp.SHAPE_TOL))
+    alpha = float(an.attrs.get("alpha", cmp.ALPHA))
     p = cmp.p_values({"p_shape": s.cmp_p_shape.values, "p_profile_gap": sk.cmp_p_profile_gap.values,
                       "p_dip": sk.cmp_p_dip.values, "p_arching": s.cmp_p_arching.values})
-    return dict(name=name, kernel=float(k), tol=tol, alpha=float(an.attrs.get("alpha", cmp.ALPHA)),
+    return dict(name=name, kernel=float(k), tol=tol, alpha=alpha,
                 shape={m: dict(rel=float(r), lo=float(lo), hi=float(hi), diff=float(dd), ref=float(ref))
                        for m, r, lo, hi, dd, ref in zip(cmp.SHAPES, rel, rlo, rhi, s.cmp_shape_diff.values,
                                                         s.cmp_shape_reference.values)},
                 matched=cmp.shape_matched(rel, tol), resolved=cmp.equivalence_resolved(rlo, rhi, tol),
-                p=p, differing=cmp.differing(p, float(an.attrs.get("alpha", cmp.ALPHA))),
+                p=p, differing=cmp.differing(p, alpha),
                 dip=float(sk.cmp_dip_diff), dip_lo=float(sk.cmp_dip_diff_lo), dip_hi=float(sk.cmp_dip_diff_hi),
                 gap=float(sk.cmp_profile_gap), gap_lo=float(sk.cmp_profile_gap_lo), gap_hi=float(sk.cmp_profile_gap_hi),
                 arching=float(s.cmp_arching_diff), arching_lo=float(s.cmp_arching_diff_lo),
                 arching_hi=float(s.cmp_arching_diff_hi))
+
+
+def control_outcomes(an):
+    """``[(name, differs, expected)]`` of the comparisons that control the test (those of
+    :data:`COMPARISONS` with a required outcome), the null control (must not differ) first:
+    whether the test finds the groups different (None when ``an`` lacks the comparison) and
+    whether it must."""
+    have = an.comparison.values if "comparison" in an.dims else ()
+    rows = [(name, bool(comparison_summary(an, name)["differing"]) if name in have else None, row[3])
+            for name, row in COMPARISONS.items() if row[3] is not None]
+    return sorted(rows, key=lambda r: r[2])

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from ncd.figures.fig4_history.analysis import comparison_summary
+from ncd.figures.fig4_history.analysis import comparison_summary, control_outcomes
 from ncd.shared.verdict import DIFFERS, NOT_TESTED, REPRODUCED, judged
 
 PARALLEL_DEG = 10.0      # "approximately parallel": within 10° of the flank, at most half its slope
@@ -74,19 +74,21 @@ def fig4_history_arching(results):
                   "to it than to the horizontal (no arching)", "s5-parallel-to-surface", rel)
 
 
+CONTROL_WORDS = {"same": "two halves of the point piles", "layer": "layer against heap"}
+
+
 def controls_hold(an):
-    """``(ok, text)``: the comparison's two controls as required (two halves of the point
-    piles not different, the layer different from the heap); a comparison whose test fails
-    its controls judges nothing."""
+    """``(ok, text)``: the comparison's controls as required (:func:`control_outcomes`: two
+    halves of the point piles not different, the layer different from the heap); a
+    comparison whose test fails its controls judges nothing."""
     parts, ok = [], True
-    for c, expect_differ, what in (("same", False, "two halves of the point piles"),
-                                   ("layer", True, "layer against heap")):
-        if "comparison" not in an.dims or c not in an.comparison.values:
+    for name, differs, expected in control_outcomes(an):
+        what = CONTROL_WORDS[name]
+        if differs is None:
             return False, f"control {what} absent"
-        got = bool(comparison_summary(an, c)["differing"])
-        ok &= got == expect_differ
-        parts.append(f"{what} {'different' if got else 'not different'}"
-                     f"{'' if got == expect_differ else ' (control FAILS)'}")
+        ok &= differs == expected
+        parts.append(f"{what} {'different' if differs else 'not different'}"
+                     f"{'' if differs == expected else ' (control FAILS)'}")
     return ok, "controls: " + ", ".join(parts)
 
 

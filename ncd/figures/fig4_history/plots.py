@@ -10,13 +10,16 @@ controls (:func:`comparison_text`).
 import matplotlib.pyplot as plt
 import numpy as np
 
-from ncd.figures.fig4_history.analysis import CERTIFIED_TEXT, comparison_summary, exact_summary
+from ncd.figures.fig4_history.analysis import CERTIFIED_TEXT, comparison_summary, control_outcomes, exact_summary
 from ncd.figures.fig4_history.compare import SHAPES
 
 COLORS = {"point": "C3", "rain": "C0", "layer": "C2"}
 LABELS = {"point": "point source", "rain": "rain", "layer": "layer"}
 SHAPE_LABELS = {"flank_slope": "flank slope", "apex_height": "apex height", "base_half_width": "base half-width"}
 COMPARISON_LABELS = {"rain": "rain − point", "same": "odd − even point piles", "layer": "layer − point"}
+CONTROL_PAGE_WORDS = {"same": "two halves of the point-source piles (even against odd members: one history, "
+                              "different seeds)",
+                      "layer": "the layer against the point-source heap (a difference known to exist)"}
 
 
 def plot_piles(ax, piles):
@@ -329,15 +332,12 @@ stress profiles over $|x| \\le L$ {m['gap']:.3f} W/2L; pooled median arching dev
 histories are **{_verdict_words(m)}**."""
     if not m["matched"]:
         text += " The shapes do not match, so a difference mixes history with shape."
-    for c, what, expect in (("same", "two halves of the point-source piles (even against odd members: one "
-                                      "history, different seeds)", "not different"),
-                            ("layer", "the layer against the point-source heap (a difference known to exist)",
-                             "different")):
-        if c in s["comparisons"]:
+    for c, differs, expected in control_outcomes(an):
+        if differs is not None:
             x = s["comparisons"][c]
-            got = "different" if x["differing"] else "not different"
-            text += (f"\n\n*Control*, {what}: p = {_p_list(x)}; **{_verdict_words(x)}** "
-                     f"({'as required' if got == expect else 'the control FAILS: expected ' + expect}).")
+            outcome = "as required" if differs == expected else \
+                "the control FAILS: expected " + ("different" if expected else "not different")
+            text += f"\n\n*Control*, {CONTROL_PAGE_WORDS[c]}: p = {_p_list(x)}; **{_verdict_words(x)}** ({outcome})."
     return text
 
 
