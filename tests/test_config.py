@@ -14,7 +14,7 @@ SCHEMAS = ROOT / "workflow" / "schemas"
 CONFIG = yaml.safe_load((ROOT / "config.yaml").read_text())
 REDUCED = yaml.safe_load((ROOT / "tests" / "config_reduced.yaml").read_text())
 QUICK = yaml.safe_load((ROOT / "config" / "quick.yaml").read_text())
-REALIZATIONS = {"runs", "piles", "seeds", "random_runs"}     # counts of ensemble members, piles, flows
+REALIZATIONS = {"runs", "piles", "seeds", "random_runs", "per_mu", "control"}     # counts of ensemble members, piles, flows, packings
 RULE_FILES = [f for f in CONFIG if (ROOT / "workflow" / "rules" / f"{f}.smk").exists() and f != "bench"]
 
 

@@ -156,17 +156,19 @@ def elongated_eta(n, mu):
     return np.sqrt((n - 1 + n * mu ** 2) / (2 * n + 1)) / g
 
 
+@pytest.mark.parametrize("directions", ["random", "coordinate"])
 @pytest.mark.parametrize("mu", [0.003, 0.5])
-def test_uniform_sample_of_an_elongated_set_with_implicit_equalities(mu):
+def test_uniform_sample_of_an_elongated_set_with_implicit_equalities(mu, directions):
     """Widths over 4 decades, far vertices as dispersed starts, two contacts fixed at zero by
     implicit equalities: the sampler works in the 2n - 1 dimensions the exact LPs count, its
-    two chains agree at the first length, and eta_U matches the closed form.  (One pilot
-    from an isotropic start, chains burnt in for 50 dim steps: R-hat 24 here.)"""
+    two chains agree at the first length, and eta_U matches the closed form, with random
+    directions and with coordinate ones in the rounded frame.  (One pilot from an isotropic
+    start, chains burnt in for 50 dim steps: R-hat 24 here.)"""
     n = 5
     sl = elongated_slice(n, mu)
     m = ge.exact_measures(sl.H, sl.F, sl.mu)
     assert (m["dim_AC_rank"], m["dim_AC_lp"]) == (2 * n - 1, 2 * n - 1)
-    u = dict(per_chain=2000, max_per_chain=2000, rounds=1, burn=20)
+    u = dict(per_chain=2000, max_per_chain=2000, rounds=1, burn=20, directions=directions)
     uni = gu.uniform_sample(sl, m, u, lambda k: np.random.default_rng((k, 5)))
     assert uni["dimension"] == 2 * n - 1 and uni["per_chain"] == 2000
     assert gu.chains_agree(uni["gap"], uni["rhat"]) and uni["rhat"] < 1.1, (uni["gap"], uni["rhat"])
@@ -182,6 +184,21 @@ def test_uniform_samples_reject_points_of_another_space():
     P = ForcePolytope(sp.csr_matrix([[1.0, 0.0, 1.0, 0.0]]), [-1.0], 0.5)
     with pytest.raises(ncd.InputError, match="points"):
         P.uniform_samples(lambda k: np.random.default_rng(k), 2, 10, points=np.zeros((3, 3)))
+    with pytest.raises(ncd.InputError, match="directions = 'gibbs'"):
+        P.uniform_samples(lambda k: np.random.default_rng(k), 2, 10, directions="gibbs")
+
+
+def test_coordinate_directions_keep_the_uniform_law_on_the_segment():
+    """The frictionless segment r_n1 + r_n2 = 1 (each r_n uniform on [0, 1]) sampled by
+    coordinate hit-and-run: mean 1/2 and variance 1/12 within sampling error, both chains."""
+    P = ForcePolytope(sp.csr_matrix([[1.0, 0.0, 1.0, 0.0]]), [-1.0], 0.0)
+    x, info = P.uniform_samples(lambda k: np.random.default_rng((k, 2)), 2, 4000, dispersed=True,
+                                directions="coordinate")
+    assert info["dimension"] == 1 and info["rhat"] < 1.02
+    for chain in x.reshape(2, 4000, 4):
+        assert chain[:, 0].mean() == pytest.approx(0.5, abs=0.02)
+        assert chain[:, 0].var() == pytest.approx(1 / 12, rel=0.06)
+        np.testing.assert_allclose(chain[:, 0] + chain[:, 2], 1.0, atol=1e-12)
 
 
 def test_eta_u_is_a_standard_deviation_over_mean_force():

@@ -15,6 +15,7 @@ clouds are compared).  Nothing here knows about discs: it takes ``H, F, mu``.
 """
 import numpy as np
 import scipy.sparse as sp
+from scipy.linalg import solve_triangular
 from scipy.optimize import linprog
 
 from ncd.core import validate
@@ -54,6 +55,43 @@ def _hit_and_run(G, slack, y, L, thin, normals, uniforms):
             out[k] = y
             k += 1
     return out
+
+
+@njit(cache=True)
+def _coordinate_hit_and_run(GLt, slack, z, thin, coords, uniforms):
+    """Coordinate hit-and-run in ``{z : G L z <= b}`` (the rounded frame ``y = L z``): each
+    step moves one coordinate ``coords[s]`` of ``z``, so the ray test reads one column of
+    ``G L`` (row ``coords[s]`` of ``GLt``) and the slack update is one axpy, O(m) a step
+    instead of the O(d^2 + m d) of a random direction.  Each coordinate move is a
+    reversible kernel that keeps the uniform law, and so is their random mixture
+    (coordinate hit-and-run with rounding, Haraldsdottir et al., Bioinformatics 33, 1741,
+    2017).  ``slack = b - G L z`` and ``z`` are modified in place; returns ``z`` every
+    ``thin`` steps."""
+    m = GLt.shape[1]
+    steps = coords.shape[0]
+    out = np.empty((steps // thin, z.shape[0]))
+    k = 0
+    for s in range(steps):
+        j = coords[s]
+        lo = -np.inf
+        hi = np.inf
+        for i in range(m):
+            g = GLt[j, i]
+            if g > 0.0:
+                hi = min(hi, slack[i] / g)
+            elif g < 0.0:
+                lo = max(lo, slack[i] / g)
+        lam = lo + (hi - lo) * uniforms[s]
+        z[j] += lam
+        for i in range(m):
+            slack[i] = max(slack[i] - lam * GLt[j, i], 0.0)
+        if (s + 1) % thin == 0:
+            out[k] = z
+            k += 1
+    return out
+
+
+DIRECTIONS = ("random", "coordinate")
 
 
 class ForcePolytope:
@@ -211,7 +249,7 @@ class ForcePolytope:
         return x0, Z, Gz[keep], b[keep], implicit
 
     def uniform_samples(self, rng_of, n_chains, per_chain, thin=None, burn=None, rounds=2, implicit=None,
-                        dispersed=False, points=None):
+                        dispersed=False, points=None, directions="random"):
         """Points drawn uniformly from ``A ∩ C`` (forces, shape (n_chains * per_chain, 2 kappa)).
 
         Hit-and-run in the affine hull of ``A ∩ C`` from its Chebyshev centre,
@@ -227,6 +265,9 @@ class ForcePolytope:
         range LPs) whose covariance, plus the inscribed ball, shapes the first pilot's
         directions: an isotropic first pilot crawls along a set whose widths span
         several decades and leaves a covariance no better than its start.
+        ``directions``: ``"random"`` (Gaussian directions shaped by the rounding) or
+        ``"coordinate"`` (coordinate hit-and-run in the rounded frame,
+        :func:`_coordinate_hit_and_run`: the same steps at O(m) each instead of O(d^2 + m d)).
         ``rng_of(k)`` is the generator of chain ``k``; pilots use ``n_chains + r``.
         Returns ``(samples, info)``; ``info`` has the dimension, the implicit
         equalities and the largest Gelman-Rubin R-hat over coordinates.
@@ -238,6 +279,8 @@ class ForcePolytope:
         rounds = validate.integer("rounds", rounds, 0, 100)
         if points is not None:
             points = validate.array("points", points, (None, 2 * self.n_contacts))
+        if directions not in DIRECTIONS:
+            raise InputError(f"directions = {directions!r}: expected one of {DIRECTIONS}")
         if not callable(rng_of):
             raise InputError(f"rng_of must be a callable k -> numpy Generator; got {rng_of!r}")
         if not self.is_bounded():
@@ -272,6 +315,14 @@ class ForcePolytope:
         def chain(rng, n_keep, L, y, n_burn):
             blocks = [max(n_burn // thin, 1)] + [min(1000, n_keep - k) for k in range(0, n_keep, 1000)]
             keep = []
+            if directions == "coordinate":
+                GLt = np.ascontiguousarray((Gz @ L).T)
+                z = solve_triangular(L, y, lower=True)
+                for n in blocks:                              # the first block is burn-in
+                    slack = b - GLt.T @ z                     # fresh slack: no drift
+                    keep.append(_coordinate_hit_and_run(GLt, slack, z, thin, rng.integers(0, d, n * thin),
+                                                        rng.uniform(size=n * thin)) @ L.T)
+                return np.concatenate(keep[1:])
             for n in blocks:                                  # the first block is burn-in
                 slack = b - Gz @ y                            # fresh slack: no drift
                 keep.append(_hit_and_run(Gz, slack, y, L, thin, rng.standard_normal((n * thin, d)),

@@ -125,7 +125,8 @@ def _two_chains(sl, exact, u, per_chain, rng_of, feas_tol):
     x, info = P.uniform_samples(rng_of, 2, per_chain, thin=u.get("thin", 4) * d, rounds=u["rounds"],
                                 burn=int(u.get("burn", 20) * d * d),
                                 implicit=exact["implicit"], dispersed=True,
-                                points=exact["lp_points"] / stretch.ravel())
+                                points=exact["lp_points"] / stretch.ravel(),
+                                directions=u.get("directions", "random"))
     x = x.reshape(2, per_chain, k, 2) * stretch
     etas = [eta_u(c) for c in x]
     eta = eta_u(x.reshape(-1, k, 2))
