@@ -35,8 +35,7 @@
 # friction, friction switched on for the sampling) with $\eta$ rising monotonically; and a
 # history force state closer to the centre of the solution set than random samples.
 #
-# **What we compute.** Their geometry, scaled down for the default run (sizes below; their
-# size: `config/unger.yaml`). The top plate is a mobile rigid body of the scene
+# **What we compute.** Their geometry and protocol at their size (sizes below). The top plate is a mobile rigid body of the scene
 # (`ncd/figures/fig5_governing/plates.py`): its mass enters the Delassus blocks of its contacts, NLGS moves
 # it as it moves a disc, and its vertical equilibrium is a row of $A$. Its contacts are
 # frictionless, so that it receives vertical forces only and translates along its normal
@@ -89,8 +88,8 @@ display(Markdown(
      "shows η_U against the number of samples. " if n_w else "**The walk never moves in this run** (every "
      "slice determinate). ") + "What the verdicts use are means over packings: from half the samples to all "
     f"of them the mean η_U at each μ moves by at most {gc.mean_settling(ds, 0):.1%} in the plates series and "
-    f"{gc.mean_settling(ds, 1):.1%} in the control series (one packing). Unger et al. drew 100 samples per "
-    "packing; `config/unger.yaml` does too."))
+    f"{gc.mean_settling(ds, 1):.1%} in the control series. Unger et al. drew 100 samples per packing; this run "
+    f"drew {cfg['walk']['samples']}."))
 
 # %% [markdown]
 # ## The figure
@@ -148,8 +147,7 @@ display(Markdown(
     f"frictionless history state is closer to the centre than the mean uniform sample in {closer_k} of {n_k} "
     f"analyses (median fraction of uniform samples closer: {rank_k:.2f}), against {closer} of {n_c} for "
     "packings built at μ: what sets the history state's place in the set is the history (a state built "
-    "with friction keeps contacts at the Coulomb limit, on the boundary), not the sampler. The default run "
-    "is smaller than theirs (sizes above); `config/unger.yaml` runs their size through the same code."))
+    "with friction keeps contacts at the Coulomb limit, on the boundary), not the sampler."))
 
 # %% [markdown]
 # ## Flows: indeterminate steps against friction, time step and slope
