@@ -50,13 +50,16 @@
 #   py-spy, every sample of every job filed under its figure and under numba kernels, LP
 #   solvers, other compiled code or Python (`ncd.studies.bench.profile`);
 # * `exact_sets.nc`: the LPs and LP time of the exact angle ranges of every history pile
-#   with an exact file (`ncd.studies.bench.solver.exact_costs`), the size study's included.
+#   with an exact file (`ncd.studies.bench.solver.exact_costs`), the size study's included;
+# * `sampler.nc`: Figure 5's uniform sampler with random and with coordinate directions on
+#   the same slices (`ncd.figures.fig5_governing.sampler`).
 
 # %%
 import matplotlib
 import xarray as xr
 from IPython.display import HTML, Markdown, display
 
+from ncd.figures.fig5_governing import sampler
 from ncd.pages.notebook import paths, save
 from ncd.studies.bench import page
 
@@ -64,7 +67,7 @@ matplotlib.use("Agg")  # the figure is shown once, as the saved PNG
 
 # Snakemake's object, or by hand (from the repository or notebooks/) the files under results/
 NAMES = ["core", "sweeps", "tolerance", "tolerance_problems", "ensemble", "peer", "rules", "dag", "profile",
-         "exact_sets"]
+         "exact_sets", "sampler"]
 snakemake = paths("bench", NAMES, globals().get("snakemake"))
 data = {name: xr.load_dataset(getattr(snakemake.input, name)) for name in NAMES}
 core, sweeps, tol_ds, tol_pb = data["core"], data["sweeps"], data["tolerance"], data["tolerance_problems"]
@@ -238,3 +241,18 @@ display(HTML(page.table(page.hot_spots_frame(data["profile"]))))
 
 # %%
 display(HTML(page.table(page.exact_frame(data["exact_sets"]))), Markdown(page.exact_sentence(data["exact_sets"])))
+
+# %% [markdown]
+# ## Figure 5's uniform sampler: random against coordinate directions
+#
+# Figure 5 samples each slice's A ∩ C uniformly by hit-and-run in a rounded frame
+# (`docs/governing.md`). A Gaussian direction costs O(d² + m d) a step; a coordinate of the
+# rounded frame costs O(m). Both leave the uniform law invariant. Here both run on the same
+# slices of this run (the first indeterminate one at each μ of the plates series), with the
+# same settings and generators. For each: its CPU time (pilot, burn-in and redraws
+# included), η_U, the two chains' gap and R-hat, and the points per chain the mixing check
+# needed (`snakemake -j2 bench_sampler`).
+
+# %%
+cmp = data["sampler"]
+display(HTML(page.table(sampler.frame(cmp), index=False)), Markdown(sampler.summary(cmp)))

@@ -330,3 +330,25 @@ def test_bench_dag_has_every_job_and_a_critical_path(bench_results):
     assert path.rule.values[-1] == "index"
     np.testing.assert_allclose(dag.attrs["critical_path_s"], float(path.alone_s.sum()), rtol=1e-9)
     assert dag.attrs["ideal_s"] >= max(dag.attrs["critical_path_s"], dag.attrs["cpu_s"] / dag.attrs["cores"]) - 1e-9
+
+
+def test_bench_sampler_kinds_agree_on_the_same_slices(results):
+    """sampler.nc: on the same slices of the run, random and coordinate directions are both
+    uniform samplers, so where both kinds' chains agree their pooled eta_U must agree within
+    the gap allowed between two chains of one kind (MIXED_GAP); a slice at every mu of the
+    plates series with an indeterminate bounded slice; every time positive."""
+    from ncd.figures.fig5_governing.unger import MIXED_GAP
+    path = results / "bench" / "sampler.nc"
+    if not path.exists():
+        pytest.skip(f"no {path} (run `snakemake -j2 bench`)")
+    s = xr.load_dataset(path)
+    p = xr.load_dataset(results / "fig5_governing" / "packings.nc")
+    ok = (p.kind.values == 0) & (p.bounded.values == 1) & (p.dim_AC_rank.values > 0)
+    assert sorted(set(np.round(s.mu.values, 12))) == sorted(set(np.round(p.mu.values[ok], 12)))
+    assert list(s.directions.values) == ["random", "coordinate"]
+    assert (s.cpu_seconds.values > 0).all()
+    both = (s.mixed.values == 1).all(axis=1)
+    assert both.any()
+    eta = s.eta_uniform.values[both]
+    assert (np.abs(eta[:, 1] / eta[:, 0] - 1) <= MIXED_GAP).all(), eta
+    np.testing.assert_array_equal(s.dimension.values, p.dim_AC_rank.values[s.analysis.values])

@@ -231,3 +231,26 @@ def test_bench_figure_is_readable():
     titles = [ax.get_title() for ax in fig.axes]
     assert [t[:3] for t in titles] == ["(a)", "(b)", "(c)", "(d)"]
     assert len(fig.axes[3].patches) == 15                # the fifteen slowest rules
+
+
+def test_sampler_table_and_sentence():
+    """Two slices, coordinate directions 4 and 5 times cheaper, eta_U 2 % and 10 % apart:
+    the sentence gives the median ratio, the totals and the largest difference."""
+    import xarray as xr
+
+    from ncd.figures.fig5_governing import sampler
+    s = xr.Dataset({"cpu_seconds": (("case", "directions"), [[8.0, 2.0], [10.0, 2.0]]),
+                    "eta_uniform": (("case", "directions"), [[0.10, 0.102], [0.20, 0.18]]),
+                    "gap": (("case", "directions"), [[0.01, 0.02], [0.03, 0.01]]),
+                    "rhat": (("case", "directions"), [[1.01, 1.02], [1.03, 1.05]]),
+                    "per_chain": (("case", "directions"), [[1000, 1000], [1000, 4000]]),
+                    "mixed": (("case", "directions"), [[1, 1], [1, 0]]),
+                    "mu": ("case", [0.01, 0.1]), "dimension": ("case", [40, 90])},
+                   coords={"directions": ["random", "coordinate"]})
+    text = sampler.summary(s)
+    assert "On 2 slices (dim(A ∩ C) 40–90)" in text and "median 1/4.5" in text
+    assert "4 s against 18 s" in text and "median 6.0% (largest 10.0%)" in text
+    assert "2 (random) and 1 (coordinate) of 2" in text
+    df = sampler.frame(s)
+    assert list(df["coordinate: points per chain"]) == [1000, 4000] and df.shape == (2, 12)
+    assert "No indeterminate slice" in sampler.summary(s.isel(case=slice(0, 0)))

@@ -10,6 +10,8 @@
 #   rules     wall time of every rule of the figures' run       -> results/bench/rules.nc
 #   dag       CPU seconds of every job of the default run and the
 #             critical path of its DAG                          -> results/bench/dag.nc
+#   sampler   Figure 5's hit-and-run, random and coordinate directions on the same slices
+#                                                              -> results/bench/sampler.nc
 #   profile   the figures run again with config/quick.yaml's counts in a scratch directory
 #             under py-spy: each figure's share of CPU in numba kernels, LP solvers,
 #             other compiled code and Python                    -> results/bench/profile.nc
@@ -156,6 +158,29 @@ rule bench_exact:
         "../scripts/bench_exact.py"
 
 
+rule bench_sampler:
+    """Figure 5's uniform sampler with random and with coordinate directions in the rounded
+    frame, on the same slices of this run's packings (ncd.figures.fig5_governing.sampler)."""
+    input:
+        packings="results/fig5_governing/packings.nc",
+        code=code_of("bench_sampler"),
+    output:
+        "results/bench/sampler.nc",
+    threads: BENCH_THREADS
+    params:
+        config=without_shards(section("fig5_governing")),
+        per_mu=CFGB["sampler"]["per_mu"],
+        root_seed=CFGB["sampler"]["root_seed"],
+    log:
+        log(FIGB, "sampler"),
+    benchmark:
+        bench(FIGB, "sampler")
+    conda:
+        CONDA_ENV
+    script:
+        "../scripts/bench_sampler.py"
+
+
 rule bench_dag:
     """CPU seconds of every job of the default run and the critical path of its DAG
     (the job graph from a dry run, the times from the benchmark files)."""
@@ -220,6 +245,7 @@ rule bench_notebook:
         dag="results/bench/dag.nc",
         profile="results/bench/profile.nc",
         exact_sets="results/bench/exact_sets.nc",
+        sampler="results/bench/sampler.nc",
         notebook=notebook_file("bench"),
         notebook_py=notebook_file("bench", "py"),
         code=notebook_code("bench"),
