@@ -13,6 +13,10 @@ def _span(values, default):
     return f"{lo}" if lo == hi else f"{lo}–{hi}"
 
 
+DIRECTION_WORDS = {"random": "hit-and-run along Gaussian directions of a rounded frame",
+                   "coordinate": "coordinate hit-and-run in a rounded frame (docs/governing.md)"}
+
+
 def study_summary(ds, cfg):
     """One paragraph of the study's numbers: packings, slices, dimensions, boundedness, walk
     and uniform-sample acceptance (the page's first measured paragraph)."""
@@ -34,7 +38,7 @@ def study_summary(ds, cfg):
         f"cell's in {int(ds.bounded_cell.sum())} of them. Random walk: {ds.sizes['sample'] - 1} rounds per analysis, "
         f"{int(ds.walk_ok.sum() - ds.sizes['packing'])} of {(ds.sizes['sample'] - 1) * ds.sizes['packing']} relaxed states "
         f"points of A ∩ C (a failed round leaves the walk in place). Uniform sample: 2 chains of {_span(ds.uniform_per_chain, u['per_chain'])} "
-        f"points from dispersed starts (4 times longer, up to {u.get('max_per_chain', u['per_chain'])}, where "
+        f"points from dispersed starts, {DIRECTION_WORDS[u.get('directions', 'random')]} (4 times longer, up to {u.get('max_per_chain', u['per_chain'])}, where "
         f"shorter chains did not agree), in the hull of the rank count (no thin direction dropped: its dimension is "
         f"dim(A∩C) by rank count in {int((ds.dim_uniform == ds.dim_AC_rank).sum())} of {int(ds.bounded.sum())}); they agree (η_U within {MIXED_GAP:.0%}, R-hat ≤ {MIXED_RHAT}) on "
         f"{int(ds.mixed.sum())} of {int(ds.bounded.sum())} analyses; the others (at μ = {others}) are left out of "
