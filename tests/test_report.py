@@ -270,3 +270,17 @@ def test_every_multi_page_sentence_has_a_rule_the_index_states(tmp_path):
         assert c.get("rule", "all") in ("all", "any") or c["rule"] in figs, c["id"]
         if len(figs) > 1:
             assert rule, c["id"]
+
+
+def test_the_abstract_names_the_size_of_unger_et_al_s_verdicts():
+    """Unger et al.'s findings are judged at the run's size, named beside theirs; a config
+    without Figure 5 names none."""
+    from ncd.pages.report import unger_size
+    cfg = {"fig5_governing": {"packings": {"n_discs": 60, "width_radii": 23, "slice_radii": 16, "per_mu": 10,
+                                           "n_mu": 8}, "walk": {"samples": 30}}}
+    size = unger_size(cfg)
+    assert size.startswith("60 discs, 23 R wide, a 16 R slice, 10 packings at each of 8 μ, 30 walk samples")
+    assert "Unger et al.: 200 discs" in size and unger_size({}) == ""
+    c = {"id": "unger-peak", "section": "Unger et al. 2005", "quote": "q", "source": UNGER}
+    text = abstract([(c, [("f", _v(DIFFERS))], DIFFERS, "")], size)
+    assert "at this run's size (60 discs, 23 R wide" in text

@@ -114,11 +114,23 @@ def _short(quote, words=12):
     return " ".join(w[:words]) + (" …" if len(w) > words else "")
 
 
-def abstract(sentences):
+def unger_size(config):
+    """The size Figure 5's verdicts on Unger et al.'s findings come from, in words, beside
+    theirs (200 discs, 42 R wide, a 28 R slice, 100 walk samples); empty without the section."""
+    f = config.get("fig5_governing") or {}
+    p, w = f.get("packings") or {}, f.get("walk") or {}
+    if "n_discs" not in p:
+        return ""
+    return (f"{p['n_discs']} discs, {p.get('width_radii')} R wide, a {p.get('slice_radii')} R slice, {p.get('per_mu')} "
+            f"packings at each of {p.get('n_mu')} μ, {w.get('samples')} walk samples per analysis; Unger et al.: "
+            "200 discs, 42 R, a 28 R slice, 100 samples")
+
+
+def abstract(sentences, size=""):
     """The findings first, generated from the verdicts: how many sentences reproduce, which
     differ and by what measured value, how many hold by construction or are not tested, the
     pairs of sentences whose verdicts pull apart (the table's ``see``) with both measured
-    values, and Unger et al.'s findings at this run's size."""
+    values, and Unger et al.'s findings at this run's size (``size``: :func:`unger_size`)."""
     e = html.escape
     counts = tally(sentences)
     by_id = {c["id"]: (c, rows, v) for c, rows, v, _ in sentences}
@@ -144,7 +156,8 @@ def abstract(sentences):
         parts.append(f"<b>Verdicts that pull apart</b>, with what each measured:<ul>{''.join(p for _, p in pulls)}</ul>")
     unger = tally(sentences, UNGER)
     if sum(unger.values()):
-        parts.append("Beyond the paper, the findings of Unger, Kertész &amp; Wolf at this run's size: "
+        parts.append("Beyond the paper, the findings of Unger, Kertész &amp; Wolf at this run's size"
+                     + (f" ({e(size)})" if size else "") + ": "
                      + ", ".join(f"{k} {e(v)}" for v, k in unger.items() if k) + ".")
     geng = [(c, rows) for c, rows, v, _ in sentences if c.get("source") == GENG]
     for c, rows in geng:
@@ -224,7 +237,7 @@ run's data when the page is built, by the same function that writes the claim on
 goes to that paragraph, the data links to the files read. Each row states its criterion as written in the table before
 the data (what is measured, over which set, the threshold and its reason) and, where its words differ, how the judging
 function applied it.</p>
-{abstract(sentences)}
+{abstract(sentences, unger_size(config))}
 <p><b>Verdicts, one per sentence of the paper:</b> {e(summary)}. <span class="small">reproduced: the paper's
 statement holds by the criterion given; differs: it does not; consistent: it holds by construction of the method or
 is a definition (illustrated, not tested); beyond the paper: a measurement the paper could not make (an open
