@@ -491,3 +491,13 @@ def test_mean_settling_compares_means_over_packings():
     full = (np.sqrt(1.2) / 1.8 + np.sqrt(1.2) / 2.8) / 3
     assert gc.mean_settling(ds) == pytest.approx(1 - np.sqrt(4 / 3) / (8 / 3) / 3 / full, rel=1e-12)
     assert gc.mean_settling(ds, kind=1) == 0.0
+
+
+def test_analysis_shards_interleave_and_partition_the_table():
+    """Each shard holds every n-th analysis (so every shard spans the mu grid, whose small
+    values cost most), and the shards together hold each analysis once."""
+    parts = [fg.analysis_members(104, k, 8) for k in range(8)]
+    np.testing.assert_array_equal(np.sort(np.concatenate(parts)), np.arange(104))
+    np.testing.assert_array_equal(parts[1][:3], [1, 9, 17])
+    with pytest.raises(ValueError, match="shard 8 is outside 0..7"):
+        fg.analysis_members(104, 8, 8)

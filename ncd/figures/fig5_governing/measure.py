@@ -328,11 +328,25 @@ SCALARS = {"n_contacts": "contacts kappa in the slice", "rank_H": "rank of the s
            "are those its reference forces balance, see exact_rest)"}
 
 
+def analysis_members(n_analyses, shard, n_shards):
+    """Analyses of shard ``shard`` among ``n_shards``: every ``n_shards``-th from ``shard``
+    (each shard then holds every mu; the shards partition the table)."""
+    every = shard_members(n_analyses, 0, 1)                  # validated 0..n-1
+    if not (0 <= shard < n_shards):
+        raise ValueError(f"shard {shard} is outside 0..{n_shards - 1}")
+    return every[shard::n_shards]
+
+
 def analysis_shard(builds, cfg, shard, n_shards, progress=None):
-    """The analyses of one shard -> Dataset (dims packing, sample, contact, chain)."""
+    """The analyses of one shard -> Dataset (dims packing, sample, contact, chain).
+
+    A shard takes every ``n_shards``-th analysis (:func:`analysis_members`), not a
+    contiguous block: an analysis at small mu costs several times one at large mu, and
+    blocks of the table (ordered by mu) left one shard with most of the cost.  The merged
+    file is sorted by analysis, so its content does not depend on the shards."""
     p = cfg["packings"]
     table = analysis_table(p)
-    sel = shard_members(len(table["mu"]), shard, n_shards)
+    sel = analysis_members(len(table["mu"]), shard, n_shards)
     row_of = {int(b): j for j, b in enumerate(builds.build.values)}
     rows = []
     for i in sel:
@@ -435,5 +449,5 @@ def eta_table(ds, var="eta_walk", kind=0):
 
 
 __all__ = ["KINDS", "mu_values", "build_table", "analysis_table", "ballistic", "initial_cell", "build",
-           "pack_shard", "cell_of", "exact_rest", "slice_of", "coordination", "analyse", "plates_bounded", "analysis_shard",
+           "pack_shard", "cell_of", "exact_rest", "slice_of", "coordination", "analyse", "plates_bounded", "analysis_members", "analysis_shard",
            "merge", "builds_of", "mixed_only", "eta_table", "SCALARS"]
