@@ -496,8 +496,9 @@ def test_mean_settling_compares_means_over_packings():
 def test_analysis_shards_interleave_and_partition_the_table():
     """Each shard holds every n-th analysis (so every shard spans the mu grid, whose small
     values cost most), and the shards together hold each analysis once."""
-    parts = [fg.analysis_members(104, k, 8) for k in range(8)]
+    from ncd.dynamics.explore import shard_members
+    parts = [shard_members(104, k, 8, interleaved=True) for k in range(8)]
     np.testing.assert_array_equal(np.sort(np.concatenate(parts)), np.arange(104))
     np.testing.assert_array_equal(parts[1][:3], [1, 9, 17])
     with pytest.raises(ValueError, match="shard 8 is outside 0..7"):
-        fg.analysis_members(104, 8, 8)
+        shard_members(104, 8, 8, interleaved=True)

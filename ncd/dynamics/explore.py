@@ -41,13 +41,17 @@ def random_guess(rng, mu, scale):
     return np.column_stack([sn, st])
 
 
-def shard_members(n_members, shard, n_shards):
-    """Members of shard ``shard`` (0-based) among ``n_shards``: a contiguous block."""
+def shard_members(n_members, shard, n_shards, interleaved=False):
+    """Members of shard ``shard`` (0-based) among ``n_shards``: a contiguous block, or with
+    ``interleaved`` every ``n_shards``-th member from ``shard`` (for a table whose cost
+    varies along it, so that each shard takes its share of every part)."""
     n_members = validate.integer("n_members", n_members, 0)
     n_shards = validate.integer("n_shards", n_shards, 1)
     shard = validate.integer("shard", shard, 0)
     if not (0 <= shard < n_shards):
         raise ValueError(f"shard {shard} is outside 0..{n_shards - 1}")
+    if interleaved:
+        return np.arange(shard, n_members, n_shards)
     bounds = np.linspace(0, n_members, n_shards + 1).round().astype(int)
     return np.arange(bounds[shard], bounds[shard + 1])
 

@@ -278,13 +278,22 @@ def coordination(sl, cell, contacts, forces, frictional, tol=1e-9):
     return (float(count[kept].mean()) if len(kept) else np.nan), len(kept)
 
 
-def analyse(builds, j, cfg, mu, rng_walk, rng_of):
-    """Every measure of build ``j`` analysed at ``mu`` -> dict."""
-    p, e = cfg["packings"], cfg["exact"]
+def measured_slice(builds, j, cfg, mu):
+    """The middle slice of build ``j`` at friction ``mu`` and its exact measures:
+    ``(cell, contacts, forces, exact, slice, measures)`` (:func:`cell_of`, :func:`slice_of`,
+    :func:`ncd.figures.fig5_governing.exact.exact_measures` at the ``exact`` tolerances)."""
+    e = cfg["exact"]
     cell, contacts, forces, exact = cell_of(builds, j, cfg, mu)
-    sl = slice_of(cell, contacts, forces, p, exact)
+    sl = slice_of(cell, contacts, forces, cfg["packings"], exact)
     out = exact_measures(sl.H, sl.F, sl.mu, width_tol=e["width_tol"], slack_tol=e["slack_tol"],
                          feas_tol=e["feas_tol"])
+    return cell, contacts, forces, exact, sl, out
+
+
+def analyse(builds, j, cfg, mu, rng_walk, rng_of):
+    """Every measure of build ``j`` analysed at ``mu`` -> dict."""
+    e = cfg["exact"]
+    cell, contacts, forces, exact, sl, out = measured_slice(builds, j, cfg, mu)
     out["rest_exact"] = float(exact)
     out["bounded_cell"] = plates_bounded(cell, contacts)
     out["z"], out["n_nonrattlers"] = coordination(sl, cell, contacts, forces, float(builds.build_mu[j]) > 0)
@@ -328,25 +337,16 @@ SCALARS = {"n_contacts": "contacts kappa in the slice", "rank_H": "rank of the s
            "are those its reference forces balance, see exact_rest)"}
 
 
-def analysis_members(n_analyses, shard, n_shards):
-    """Analyses of shard ``shard`` among ``n_shards``: every ``n_shards``-th from ``shard``
-    (each shard then holds every mu; the shards partition the table)."""
-    every = shard_members(n_analyses, 0, 1)                  # validated 0..n-1
-    if not (0 <= shard < n_shards):
-        raise ValueError(f"shard {shard} is outside 0..{n_shards - 1}")
-    return every[shard::n_shards]
-
-
 def analysis_shard(builds, cfg, shard, n_shards, progress=None):
     """The analyses of one shard -> Dataset (dims packing, sample, contact, chain).
 
-    A shard takes every ``n_shards``-th analysis (:func:`analysis_members`), not a
+    A shard takes every ``n_shards``-th analysis (``shard_members(..., interleaved=True)``), not a
     contiguous block: an analysis at small mu costs several times one at large mu, and
     blocks of the table (ordered by mu) left one shard with most of the cost.  The merged
     file is sorted by analysis, so its content does not depend on the shards."""
     p = cfg["packings"]
     table = analysis_table(p)
-    sel = analysis_members(len(table["mu"]), shard, n_shards)
+    sel = shard_members(len(table["mu"]), shard, n_shards, interleaved=True)
     row_of = {int(b): j for j, b in enumerate(builds.build.values)}
     rows = []
     for i in sel:
@@ -449,5 +449,5 @@ def eta_table(ds, var="eta_walk", kind=0):
 
 
 __all__ = ["KINDS", "mu_values", "build_table", "analysis_table", "ballistic", "initial_cell", "build",
-           "pack_shard", "cell_of", "exact_rest", "slice_of", "coordination", "analyse", "plates_bounded", "analysis_members", "analysis_shard",
+           "pack_shard", "cell_of", "exact_rest", "slice_of", "coordination", "analyse", "plates_bounded", "measured_slice", "analysis_shard",
            "merge", "builds_of", "mixed_only", "eta_table", "SCALARS"]

@@ -10,12 +10,12 @@ chains' gap and R-hat, and the chain length the mixing check needed.
 import time
 
 import numpy as np
+import pandas as pd
 import xarray as xr
 
 from ncd.dynamics.explore import member_rng
 from ncd.exact.polytope import DIRECTIONS
 from ncd.figures.fig5_governing import measure
-from ncd.figures.fig5_governing.exact import exact_measures
 from ncd.figures.fig5_governing.unger import chains_agree, uniform_sample
 
 
@@ -32,7 +32,7 @@ def pick_slices(ds, per_mu=1):
 def compare(ds, cfg, rows, seed=0):
     """Both kinds of direction on analyses ``rows`` of ``packings.nc`` (``cfg``: the
     fig5_governing section the run used) -> Dataset over ``case`` and ``directions``."""
-    p, e, u = cfg["packings"], cfg["exact"], cfg["uniform"]
+    e, u = cfg["exact"], cfg["uniform"]
     row_of = {int(b): j for j, b in enumerate(ds.build.values)}
     rec = {k: np.full((len(rows), len(DIRECTIONS)), np.nan) for k in ("seconds", "eta", "gap", "rhat", "per_chain")}
     mixed = np.zeros((len(rows), len(DIRECTIONS)), np.int8)
@@ -40,10 +40,7 @@ def compare(ds, cfg, rows, seed=0):
     for c, i in enumerate(rows):
         j = row_of[int(ds.build_index.values[i])]
         mu[c] = float(ds.mu.values[i])
-        cell, contacts, forces, exact = measure.cell_of(ds, j, cfg, mu[c])
-        sl = measure.slice_of(cell, contacts, forces, p, exact)
-        ex = exact_measures(sl.H, sl.F, sl.mu, width_tol=e["width_tol"], slack_tol=e["slack_tol"],
-                            feas_tol=e["feas_tol"])
+        *_, sl, ex = measure.measured_slice(ds, j, cfg, mu[c])
         dim[c] = int(ex["dim_AC_rank"])
         for k, name in enumerate(DIRECTIONS):
             t0 = time.process_time()
@@ -71,7 +68,6 @@ def compare(ds, cfg, rows, seed=0):
 def frame(s):
     """Per slice: mu, dimension, and for each kind of direction its CPU seconds, eta_U, the
     chains' gap and R-hat and the points per chain the mixing check needed."""
-    import pandas as pd
     cols = {"μ": s.mu.values, "dim A ∩ C": s.dimension.values}
     for k, name in enumerate(s.directions.values):
         cols.update({f"{name}: CPU s": s.cpu_seconds.values[:, k], f"{name}: η_U": s.eta_uniform.values[:, k],
