@@ -40,10 +40,11 @@ check_config(config, FIGURES, ROOT / "workflow" / "schemas")
 ENSEMBLE_THREADS = 1
 
 # Snakemake starts the ready job of highest priority first.  The longest chains of the default
-# run (the critical path of results/bench/dag.nc: Figure 2's flow, its ensembles and census,
-# then Figure 4's pile, which fig4_bank reads) go first, so that the many short independent
-# jobs fill the cores around them instead of delaying them to the end.
-PRIORITY = {"fig2_slope": 100, "fig4_pile": 50}
+# run (the critical path of results/bench/dag.nc: Figure 2's flow, its ensembles and census;
+# Figure 5's builds and analyses, the most CPU of the run in a few long shards; then Figure 4's
+# pile, which fig4_bank reads) go first, so that the many short independent jobs fill the cores
+# around them and at the end, instead of one long shard running alone last.
+PRIORITY = {"fig2_slope": 100, "fig5_governing": 75, "fig4_pile": 50}
 
 # The code a rule runs: the import closure of its script (or notebook) inside ncd/, read from
 # the imports (ncd.pipeline.imports), so that no list of modules is kept by hand.  An edit of a

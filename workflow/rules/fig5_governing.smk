@@ -12,6 +12,7 @@ F5 = f"results/{FIG}"
 
 
 rule fig5_governing_pack:
+    priority: PRIORITY["fig5_governing"]
     input:
         code=code_of("fig5_governing_pack"),
     output:
@@ -32,6 +33,7 @@ rule fig5_governing_pack:
 
 
 rule fig5_governing_analyse:
+    priority: PRIORITY["fig5_governing"]
     input:
         packs=shard_files(FIG, "packs", CFG["shards"]),
         code=code_of("fig5_governing_analyse"),
@@ -53,6 +55,7 @@ rule fig5_governing_analyse:
 
 
 rule fig5_governing_merge:
+    priority: PRIORITY["fig5_governing"]
     input:
         packs=shard_files(FIG, "packs", CFG["shards"]),
         analyses=shard_files(FIG, "analyses", CFG["shards"]),
