@@ -138,8 +138,11 @@ def bench(figure, rule_name):
 
 
 rule code_stamp:
-    """The stamp of a source set (see ``code`` above): one line per file, its SHA-256 and path."""
+    """The stamp of a source set (see ``code`` above): one line per file, its SHA-256 and path.
+    First of all (a fraction of a second each): a rule's priority counts only once its stamp
+    exists, so stamps picked among the other ready jobs held the longest chains back."""
     localrule: True
+    priority: 1000
     input:
         lambda w: CODE_SETS[w.name],
     output:
