@@ -98,49 +98,6 @@ def test_frictionless_packing_is_isostatic_and_determinate(frictionless_cell):
     assert uni["dimension"] == 0 and uni["eta"] == 0.0
 
 
-@pytest.fixture(scope="module")
-def frictional_slice():
-    """The middle slice of a 24-disc cell built at mu = 0.05: an indeterminate A ∩ C."""
-    p = small_plates(slice_radii=8)
-    cell, forces, contacts, _ = fg.build(p, 0.05, member=1)
-    exact_forces, exact = fg.exact_rest(cell, contacts, forces, 0.05)
-    sl = fg.slice_of(cell, contacts, exact_forces, p, exact)
-    m = ge.exact_measures(sl.H, sl.F, sl.mu, feas_tol=1e-9)
-    assert m["dim_AC_rank"] >= 1
-    return sl, m
-
-
-def test_walk_projected_first_ends_on_the_same_checked_points(frictional_slice):
-    """``project_first``: rounds whose converged NLGS iterate projects on its active rows to a
-    point of A ∩ C end there, the others run the finishing stage as before.  The walk lands on
-    points that pass the same check, within 1e-6 of the force scale of those without it (the
-    iteration error beyond NLGS's 1e-8), so eta_U agrees within 1 %, far tighter than it
-    differs between packings; without the option no round is ended by the projection."""
-    sl, m = frictional_slice
-    w = dict(WALK, samples=12)
-    plain = gu.random_walk(sl, w, np.random.default_rng(5))
-    first = gu.random_walk(sl, dict(w, project_first=True), np.random.default_rng(5))
-    assert not plain["projected"].any()
-    assert first["projected"].sum() >= 3                    # the option did end rounds
-    assert first["ok"].sum() >= 10 and plain["ok"].sum() >= 10
-    np.testing.assert_array_equal(first["ok"], plain["ok"])
-    scale = np.abs(sl.F).max()
-    assert np.abs(first["samples"] - plain["samples"]).max() <= 1e-6 * scale
-    eta_plain = gu.eta_u(plain["samples"][plain["ok"]])
-    assert eta_plain > 1e-4                                  # the walk moved: a spread to compare
-    assert gu.eta_u(first["samples"][first["ok"]]) == pytest.approx(eta_plain, rel=0.01)
-    # every accepted state is inside the exact ranges (the same margin as the figure's data test)
-    for walk in (plain, first):
-        f = walk["samples"][walk["ok"]]
-        assert (f >= m["force_min"] - 1e-9 * scale).all() and (f <= m["force_max"] + 1e-9 * scale).all()
-
-
-def test_solve_discs_rejects_an_accept_that_is_not_callable(frictional_slice):
-    sl, _ = frictional_slice
-    with pytest.raises(ncd.InputError, match="accept"):
-        plates.relax(sl, None, None, ncd.SolverSettings(), accept=1.0)
-
-
 def test_slice_balanced_by_its_reference_forces(frictionless_cell):
     """Rest forces balanced to ~1e-10 only (a refinement not taken, as in thin cones): with
     ``balance`` the slice's loads are those its reference forces balance, to round-off, and its

@@ -19,7 +19,6 @@ goes non-finite or faster than ``speed_limit`` raises :class:`SimulationError`.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -129,15 +128,13 @@ def prepare_step(scene: Scene, h: float, theta: float = 0.5, gap_tolerance: floa
 
 def solve_problem(scene: Scene, problem: StepProblem, guess: ArrayLike | None = None,
                   review_order: ArrayLike | None = None, settings: SolverSettings = SolverSettings(),
-                  observe: Observer | None = None, check: bool = True,
-                  accept: Callable[[np.ndarray], bool] | None = None) -> tuple[NLGSResult, np.ndarray, np.ndarray]:
+                  observe: Observer | None = None, check: bool = True) -> tuple[NLGSResult, np.ndarray, np.ndarray]:
     """Solve a prepared step; returns ``(result, vel_f, spin_f)`` without touching the scene.
 
     ``observe(impulse, vel, spin) -> 1-D array``: the figure's observable, scaled to
     order one; NLGS then runs in chunks of ``settings.check_every`` sweeps and the run
     is converged only when it has settled too (:mod:`ncd.solver.convergence`).
-    ``check=False``: the caller has checked the arguments (as :func:`step` does).
-    ``accept``: see :func:`ncd.solver.nlgs.solve_discs`."""
+    ``check=False``: the caller has checked the arguments (as :func:`step` does)."""
     if check:
         check_step_problem(scene, problem)   # guess, review_order: in solve_discs
         check_settings_arg(settings)
@@ -145,8 +142,7 @@ def solve_problem(scene: Scene, problem: StepProblem, guess: ArrayLike | None = 
     spin = problem.free_spin.copy()
     delassus = problem.delassus(scene) if settings.finish != "none" or settings.local_exact else None
     result = solve_discs(scene, problem.contacts, vel, spin, guess, review_order, settings,
-                         bias=problem.bias, W=problem.W, observe=observe, check=check, delassus=delassus,
-                         accept=accept)
+                         bias=problem.bias, W=problem.W, observe=observe, check=check, delassus=delassus)
     return result, vel, spin
 
 

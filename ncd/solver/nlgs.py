@@ -67,7 +67,7 @@ def solve_discs(scene: Scene, contacts: Contacts, vel: np.ndarray, spin: np.ndar
                 guess: ArrayLike | None = None, review_order: ArrayLike | None = None,
                 settings: SolverSettings = SolverSettings(), bias: ArrayLike | None = None,
                 W: np.ndarray | None = None, observe: Observer | None = None, check: bool = True,
-                delassus: Delassus | None = None, accept: Callable[[np.ndarray], bool] | None = None) -> NLGSResult:
+                delassus: Delassus | None = None) -> NLGSResult:
     """Solve the core problem of one step by NLGS in disc form.
 
     ``vel, spin`` hold the free velocities on entry and the end-of-step
@@ -79,14 +79,7 @@ def solve_discs(scene: Scene, contacts: Contacts, vel: np.ndarray, spin: np.ndar
     ``delassus``: ``(W, H, M^-1)`` of :func:`ncd.solver.finish.global_delassus` for these
     contacts, which the finishing stage and local exact solves need; an ensemble of runs
     on one problem builds it once (None: built here when needed).
-    ``accept(impulse) -> bool``: tried once on a copy of the NLGS iterate (n, 2) when NLGS has
-    met ``settings.tol``, before the finishing stage; True skips that stage, because the caller
-    makes an exact point of the iterate itself and checks it (Figure 5's walk: a projection on
-    the active Coulomb rows, :meth:`ncd.exact.exact_set.ExactSet.refine`).  False, or an iterate
-    that did not converge, leaves the run exactly as without it.
     """
-    if accept is not None and not callable(accept):
-        raise InputError(f"accept = {accept!r} must be None or a callable (impulse) -> bool")
     if check:
         guess, review_order, bias, W = check_disc_problem(scene, contacts, vel, spin, guess, review_order,
                                                            settings, bias, W)
@@ -120,7 +113,7 @@ def solve_discs(scene: Scene, contacts: Contacts, vel: np.ndarray, spin: np.ndar
     result = run_nlgs(iterate, flat, order, status, problem_scale(q_free, W), settings, look)
     result.impulse = impulse
     result.local_solves = 0 if local is None else local.solves
-    if settings.finish != "none" and not (accept is not None and result.converged and accept(impulse.copy())):
+    if settings.finish != "none":
         result = polish_discs(scene, contacts, vel, spin, bias, q_free, W, flat, order, result, settings,
                               delassus)
     vel[:] = body[:-1, :2]

@@ -227,12 +227,11 @@ def slice_problem(cell, contacts, forces, y_lo, y_hi, h, balance=False):
                  check_scene(scene, "slice"), problem)    # balanced by the loads, 0 = ~1e-13 left out
 
 
-def relax(sl, guess, order, settings, accept=None):
+def relax(sl, guess, order, settings):
     """NLGS on the slice from the impulse guess ``h * forces``: ``(forces, converged, |u_f|
-    relative to the free velocities)``; ``accept(impulse)``: see :func:`ncd.solver.nlgs.solve_discs`."""
+    relative to the free velocities)``."""
     h = sl.problem.h
-    res, vel, spin = solve_problem(sl.scene, sl.problem, None if guess is None else h * guess, order, settings,
-                                   accept=accept)
+    res, vel, spin = solve_problem(sl.scene, sl.problem, None if guess is None else h * guess, order, settings)
     scale = max(np.abs(sl.problem.free_vel).max(), np.abs(sl.problem.free_spin * sl.scene.radius).max(), 1e-300)
     umax = max(np.abs(vel).max(), np.abs(spin * sl.scene.radius).max()) / scale
     return res.impulse / h, bool(res.converged), float(umax)

@@ -53,44 +53,26 @@ def random_walk(sl, w, rng):
     (bool per row: the relaxed forces are a point of ``A ∩ C`` within ``point_tol`` of the
     force scale, after a projection on their active rows when NLGS stopped short (a state
     with |H r + F| ~ 1e-8 lay up to 0.5 % of the force scale outside the exact ranges on a
-    thin set); a failed round leaves the walk where it was).  ``w["project_first"]``: a round
-    whose NLGS meets its tolerance first tries that projection on the converged iterate and
-    ends there if it is a point; only the others run the solver's finishing stage (sweeps to
-    ``finish_tol`` and LPs on the statuses, most of a round's cost at small mu), from the same
-    iterate, so they end as without it; ``projected`` (bool per row) marks the rounds the
-    projection ended."""
+    thin set); a failed round leaves the walk where it was)."""
     P = ForcePolytope(sl.H, sl.F, sl.mu)
     settings = SolverSettings(**w["solver"])
     k = len(sl.mu)
     cur = sl.reference.copy()
     out = np.full((w["samples"] + 1, k, 2), np.nan)
     ok = np.zeros(w["samples"] + 1, bool)
-    projected_round = np.zeros(w["samples"] + 1, bool)
     out[0], ok[0] = cur, _is_point(P, cur, w["point_tol"])
     a = w["noise"] * float(np.mean(cur[:, 0])) if k else 0.0
     es = ExactSet(sl.H, sl.F, sl.mu) if k else None
-    h = sl.problem.h
-    accepted = []                           # the projection that ended this round, if any
-
-    def projected(impulse):                 # NLGS met its tol: is the projection of its iterate a point?
-        p = es.refine(impulse.ravel() / h).reshape(k, 2)
-        if _is_point(P, p, w["point_tol"]):
-            accepted.append(p)
-        return bool(accepted)
-    accept = projected if w.get("project_first", False) else None
     for s in range(1, w["samples"] + 1):
         guess = cur + rng.uniform(-a, a, (k, 2))
-        accepted.clear()
-        r, _, _ = relax(sl, guess, rng.permutation(k), settings, accept=accept)
-        if accepted:
-            r, projected_round[s] = accepted[0], True
-        elif not _is_point(P, r, w["point_tol"]):   # NLGS stopped short of its finishing stage:
+        r, _, _ = relax(sl, guess, rng.permutation(k), settings)
+        if not _is_point(P, r, w["point_tol"]):   # NLGS stopped short of its finishing stage:
             r = es.refine(r.ravel()).reshape(k, 2)  # project on its active rows, then check again
         out[s] = r
         ok[s] = _is_point(P, r, w["point_tol"])
         if ok[s]:
             cur = r
-    return {"samples": out, "ok": ok, "projected": projected_round}
+    return {"samples": out, "ok": ok}
 
 
 def _is_point(P, r, tol):
