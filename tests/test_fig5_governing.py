@@ -12,6 +12,7 @@ import yaml
 
 import ncd
 from ncd.core.contacts import external_load, h_matrix
+from ncd.dynamics.explore import shard_members
 from ncd.exact.polytope import ForcePolytope
 from ncd.figures.fig5_governing import claims as gc
 from ncd.figures.fig5_governing import exact as ge
@@ -496,7 +497,6 @@ def test_mean_settling_compares_means_over_packings():
 def test_analysis_shards_interleave_and_partition_the_table():
     """Each shard holds every n-th analysis (so every shard spans the mu grid, whose small
     values cost most), and the shards together hold each analysis once."""
-    from ncd.dynamics.explore import shard_members
     parts = [shard_members(104, k, 8, interleaved=True) for k in range(8)]
     np.testing.assert_array_equal(np.sort(np.concatenate(parts)), np.arange(104))
     np.testing.assert_array_equal(parts[1][:3], [1, 9, 17])

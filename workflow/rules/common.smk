@@ -140,7 +140,7 @@ def bench(figure, rule_name):
 rule code_stamp:
     """The stamp of a source set (see ``code`` above): one line per file, its SHA-256 and path.
     First of all (a fraction of a second each): a rule's priority counts only once its stamp
-    exists, so stamps picked among the other ready jobs held the longest chains back."""
+    exists, so a stamp left among the other ready jobs would hold its chain back."""
     localrule: True
     priority: 1000
     input:
