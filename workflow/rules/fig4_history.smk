@@ -1,12 +1,12 @@
 # Figure 4's claims as statistics over piles of three construction histories.
-#   construct  one pile (history point, rain or layer, member m, n grains); a layer reads the
-#              point pile of its member (its rain falls over that pile's base width);
-#              checkpoints in results/fig4_history/checkpoints (resumed after a kill,
-#              removed at the end)                              -> piles/n<n>/<history>_<m>.nc
+#   construct  the three piles of member m (n grains), point, rain, then layer (its rain
+#              falls over the point pile's base width); one job per member, so that its
+#              start-up is paid once; checkpoints in results/fig4_history/checkpoints (resumed
+#              after a kill, removed at the end)              -> piles/n<n>/<history>_<m>.nc
 #   exact      exact angle ranges over A ∩ C at the arching cuts of the first exact.piles
 #              members of the point and rain histories (exact.solver: HiGHS's simplex, or Clarabel's
-#              interior point for 10^4 grains; ncd.figures.fig4_history.exact)
-#                                                                -> exact/n<n>/<history>_<m>.nc
+#              interior point for 10^4 grains; ncd.figures.fig4_history.exact), both
+#              histories of a member in one job                 -> exact/n<n>/<history>_<m>.nc
 #   analyse    shape match, ground stress, dip, arching over the piles, the comparison
 #              of the histories and its controls                -> analysis_n<n>.nc
 #   notebook   notebooks/fig4_history.ipynb                     -> results/figures/fig4_history.png|pdf
@@ -76,21 +76,19 @@ FH_EXACT = exact_of(NH)
 
 rule fig4_history_construct:
     input:
-        point=lambda w: f"{FH}/piles/n{w.n}/point_{w.member}.nc" if w.history == "layer" else [],
         code=code_of("fig4_history_construct"),
     output:
-        f"{FH}/piles/n{{n}}/{{history}}_{{member}}.nc",
+        **{h: f"{FH}/piles/n{{n}}/{h}_{{member}}.nc" for h in HISTORIES_H},
     wildcard_constraints:
-        history="point|rain|layer",
         member=r"\d+",
         n=r"\d+",
     params:
         config=lambda w: {k: size_cfg(w.n)[k] for k in SIM_KEYS},
-        checkpoint=lambda w: f"{FH}/checkpoints/n{w.n}/{w.history}_{w.member}.npz",
+        checkpoints=lambda w: {h: f"{FH}/checkpoints/n{w.n}/{h}_{w.member}.npz" for h in HISTORIES_H},
     log:
-        log(FIGH, "construct_n{n}_{history}_{member}"),
+        log(FIGH, "construct_n{n}_{member}"),
     benchmark:
-        bench(FIGH, "construct_n{n}_{history}_{member}")
+        bench(FIGH, "construct_n{n}_{member}")
     conda:
         CONDA_ENV
     script:
@@ -99,20 +97,20 @@ rule fig4_history_construct:
 
 rule fig4_history_exact:
     input:
-        pile=f"{FH}/piles/n{{n}}/{{history}}_{{member}}.nc",
+        **{h: f"{FH}/piles/n{{n}}/{h}_{{member}}.nc" for h in EXACT_HISTORIES},
         code=code_of("fig4_history_exact"),
     output:
-        f"{FH}/exact/n{{n}}/{{history}}_{{member}}.nc",
+        **{h: f"{FH}/exact/n{{n}}/{h}_{{member}}.nc" for h in EXACT_HISTORIES},
     wildcard_constraints:
-        history="point|rain",
         member=r"\d+",
         n=r"\d+",
     params:
         config=lambda w: {k: v for k, v in size_cfg(w.n).items() if k not in ("piles", "size")},   # one pile's ranges
+        histories=EXACT_HISTORIES,
     log:
-        log(FIGH, "exact_n{n}_{history}_{member}"),
+        log(FIGH, "exact_n{n}_{member}"),
     benchmark:
-        bench(FIGH, "exact_n{n}_{history}_{member}")
+        bench(FIGH, "exact_n{n}_{member}")
     conda:
         CONDA_ENV
     script:

@@ -106,7 +106,8 @@ rule fig5_governing:
 # Flows: Figure 2's flow across mu, h and slope, one factor at a
 # time around Figure 2's setting; scans of distinct solutions and why a line.
 #   deposit   one deposit per seed (at the base mu), shared by every setting -> shards/deposit_seed<s>.nc
-#   flow      one flow per (setting, seed), scanned                       -> shards/flow_<i>_seed<s>.nc
+#   flow      the flows of one seed, one per setting, scanned (one job per seed,
+#             so that its start-up is paid once)                          -> shards/flow_<i>_seed<s>.nc
 #   flows     every flow                                                  -> flows.nc
 from ncd.figures.fig5_governing import flow as _gflow
 
@@ -143,16 +144,15 @@ rule fig5_governing_flow:
         deposit=f"{F5}/shards/deposit_seed{{s}}.nc",
         code=code_of("fig5_governing_flow"),
     output:
-        temp(f"{F5}/shards/flow_{{i}}_seed{{s}}.nc"),
+        [temp(f"{F5}/shards/flow_{i}_seed{{s}}.nc") for i in range(len(FLOW_MU))],
     wildcard_constraints:
-        i=r"\d+",
         s=r"\d+",
     params:
         config=FLOW_CFG,
     log:
-        log(FIG, "flow_{i}_seed{s}"),
+        log(FIG, "flow_seed{s}"),
     benchmark:
-        bench(FIG, "flow_{i}_seed{s}")
+        bench(FIG, "flow_seed{s}")
     conda:
         CONDA_ENV
     script:

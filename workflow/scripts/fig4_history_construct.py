@@ -1,7 +1,8 @@
-"""Figure 4 over construction histories: build one pile of one history (checkpointed), write its file with frames."""
+"""Figure 4 over construction histories: build the three piles of one member (checkpointed), in
+the order point, rain, layer (the layer's base is the point pile's), each written with its frames.
+One job per member rather than per pile: a job's start-up (interpreter, imports, numba's cache)
+is paid once for the three."""
 import os
-
-import xarray as xr
 
 from ncd.core.errors import InputError
 from ncd.figures.fig4_history import construct as history
@@ -14,19 +15,22 @@ w = snakemake.wildcards
 if int(w.n) != cfg["grains"]["n"]:
     raise InputError(f"file name n{w.n} differs from fig4_history.grains.n = {cfg['grains']['n']}")
 half = None
-if w.history == "layer":   # the finite base of the layer: the member's point-source pile's base half-width
-    with xr.open_dataset(snakemake.input.point) as p:
-        half = float(p.attrs["base_half_width"])
-checkpoint = snakemake.params.checkpoint
-info = {}
-scene, rec, ground, eq, frames = history.construct(cfg, w.history, int(w.member), half, log, checkpoint, info)
-ds = history.pile_dataset(cfg, w.history, int(w.member), scene, rec, ground, eq, frames, half, info)
-write_dataset(ds, snakemake.output[0])
-if os.path.exists(checkpoint):
-    os.remove(checkpoint)
-d = ds.attrs["mean_diameter"]
-log.info("%s pile %s: %d grains, %d steps, %.1f ms/step (%.0f s), base half-width %.1f d, flanks %.1f/%.1f deg, "
-         "at rest |u_f| = %.2g g h, %d of %d poured grains removed off the base", w.history, w.member, ds.sizes["grain"], ds.sizes["step"],
-         1e3 * float(ds.wall_time.mean()), float(ds.wall_time.sum()), ds.attrs["base_half_width"] / d,
-         ds.attrs["left_angle"], ds.attrs["right_angle"], ds.attrs["eq_max_velocity"],
-         ds.attrs["n_removed"], ds.attrs["n_poured"])
+for name in history.HISTORIES:
+    checkpoint = snakemake.params.checkpoints[name]
+    info = {}
+    scene, rec, ground, eq, frames = history.construct(cfg, name, int(w.member), half if name == "layer" else None,
+                                                       log, checkpoint, info)
+    ds = history.pile_dataset(cfg, name, int(w.member), scene, rec, ground, eq, frames,
+                              half if name == "layer" else None, info)
+    write_dataset(ds, snakemake.output[name])
+    if name == "point":   # the finite base of the layer: this point-source pile's base half-width
+        half = float(ds.attrs["base_half_width"])
+    d = ds.attrs["mean_diameter"]
+    log.info("%s pile %s: %d grains, %d steps, %.1f ms/step (%.0f s), base half-width %.1f d, flanks %.1f/%.1f deg, "
+             "at rest |u_f| = %.2g g h, %d of %d poured grains removed off the base", name, w.member, ds.sizes["grain"],
+             ds.sizes["step"], 1e3 * float(ds.wall_time.mean()), float(ds.wall_time.sum()), ds.attrs["base_half_width"] / d,
+             ds.attrs["left_angle"], ds.attrs["right_angle"], ds.attrs["eq_max_velocity"],
+             ds.attrs["n_removed"], ds.attrs["n_poured"])
+for checkpoint in snakemake.params.checkpoints.values():   # kept to the end: a killed job resumes every pile
+    if os.path.exists(checkpoint):
+        os.remove(checkpoint)
