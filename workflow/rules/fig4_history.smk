@@ -106,7 +106,6 @@ rule fig4_history_exact:
         n=r"\d+",
     params:
         config=lambda w: {k: v for k, v in size_cfg(w.n).items() if k not in ("piles", "size")},   # one pile's ranges
-        histories=EXACT_HISTORIES,
     log:
         log(FIGH, "exact_n{n}_{member}"),
     benchmark:

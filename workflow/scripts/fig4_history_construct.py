@@ -17,11 +17,10 @@ if int(w.n) != cfg["grains"]["n"]:
 half = None
 for name in history.HISTORIES:
     checkpoint = snakemake.params.checkpoints[name]
+    base = half if name == "layer" else None
     info = {}
-    scene, rec, ground, eq, frames = history.construct(cfg, name, int(w.member), half if name == "layer" else None,
-                                                       log, checkpoint, info)
-    ds = history.pile_dataset(cfg, name, int(w.member), scene, rec, ground, eq, frames,
-                              half if name == "layer" else None, info)
+    scene, rec, ground, eq, frames = history.construct(cfg, name, int(w.member), base, log, checkpoint, info)
+    ds = history.pile_dataset(cfg, name, int(w.member), scene, rec, ground, eq, frames, base, info)
     write_dataset(ds, snakemake.output[name])
     if name == "point":   # the finite base of the layer: this point-source pile's base half-width
         half = float(ds.attrs["base_half_width"])

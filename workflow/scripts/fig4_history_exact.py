@@ -8,7 +8,7 @@ from ncd.pipeline.jobs import start
 
 log = start(snakemake)  # snakemake is injected
 cfg = snakemake.params.config
-for name in snakemake.params.histories:
+for name in snakemake.output.keys():   # the rule's histories, one file each
     pile = xr.load_dataset(snakemake.input[name])
     out = history_exact.exact_ranges(cfg, pile, log)
     out.attrs.update(provenance(cfg))

@@ -9,8 +9,8 @@ from ncd.pipeline.jobs import start
 
 log = start(snakemake)  # snakemake is injected
 s = int(snakemake.wildcards.s)
+dep = xr.load_dataset(snakemake.input.deposit)   # read-only: each flow's scene copies its arrays (make_scene)
 for i, path in enumerate(snakemake.output):
-    dep = xr.load_dataset(snakemake.input.deposit)      # read again: each flow starts from the file
     ds = governing_flow.flow_dataset(dep, snakemake.params.config, i, s, Progress(log, 0, "scans"))
     write_dataset(ds, path)
     log.info("setting %d seed %d: indeterminate %s, solutions %s", i, s, ds.indeterminate.values.ravel().tolist(),
