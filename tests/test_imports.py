@@ -70,7 +70,8 @@ def test_the_index_reads_every_figures_claims():
 def test_the_closure_follows_imports_packages_and_named_data_and_nothing_else(tmp_path):
     """A made-up package: a script importing ``pkg.a`` needs pkg/__init__.py, pkg/a.py, what
     a.py imports (``pkg.sub.b`` and so pkg/sub/__init__.py), the data file b.py names; not
-    pkg/c.py, which nobody imports, nor a data file nobody names."""
+    pkg/c.py, which nobody imports, nor a data file nobody names.  An edit is seen by the same
+    process (each file's parse is remembered under its text, not its path)."""
     pkg = tmp_path / "pkg"
     (pkg / "sub").mkdir(parents=True)
     for f in ("__init__.py", "sub/__init__.py", "c.py"):

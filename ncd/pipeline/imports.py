@@ -23,6 +23,20 @@ def imports_of(path, package=None, root_name="ncd"):
     """``(target module, names, lineno, function_local)`` of every ``root_name`` import of the
     file ``path``; ``package`` (the package folder holding ``path``) resolves relative imports."""
     path = Path(path)
+    text = path.read_text(encoding="utf-8")
+    key = (str(path), None if package is None else str(package), root_name, text)
+    if key not in _FOUND:
+        _FOUND[key] = _imports_in(text, path, package, root_name)
+    return [(t, list(n), line, local) for t, n, line, local in _FOUND[key]]
+
+
+# A workflow reads the closure of some sixty scripts and notebooks, most of which share the
+# same modules: each file's source is parsed once per process (keyed by its text, so an
+# edit is always seen) instead of once per closure it is in.
+_FOUND = {}
+
+
+def _imports_in(text, path, package, root_name):
     if package is not None and path.is_relative_to(Path(package).parent):
         mod = module_name(path, package)
         pkg = mod if path.name == "__init__.py" else mod.rpartition(".")[0]
@@ -49,8 +63,8 @@ def imports_of(path, package=None, root_name="ncd"):
                     if ours(a.name):
                         found.append((a.name, [], child.lineno, local))
             walk(child, inner)
-    walk(ast.parse(path.read_text(encoding="utf-8"), filename=str(path)), False)
-    return found
+    walk(ast.parse(text, filename=str(path)), False)
+    return tuple((t, tuple(n), line, local) for t, n, line, local in found)
 
 
 def module_file(name, package):
