@@ -1,6 +1,9 @@
 """Finishing stage: NLGS, then the projection on its statuses' polyhedron (LP)."""
+from pathlib import Path
+
 import numpy as np
 import pytest
+import scipy.sparse as sp
 from step_checks import contact_velocities as _velocities
 from step_checks import step_residual as _residual
 
@@ -365,11 +368,39 @@ def test_projection_matches_a_row_by_row_formulation():
         q = U - W @ s_star if trial % 2 == 0 else rng.normal(size=2 * n)
         s0 = s_star + 0.3 * rng.normal(size=2 * n)
         lp = finish_lp.StatusLP.local(W, q, mu, 1.0, 1.0)
-        s, _, info = finish_lp.project(lp, s0.reshape(n, 2), status)
         ref = _l1_reference(W, q, mu, s0, status)
-        assert (s is None) == (ref is None), (trial, info["status"])
+        for presolve in (True, False):          # presolve changes HiGHS's route, not the polyhedron
+            s, _, info = finish_lp.project(lp, s0.reshape(n, 2), status, presolve=presolve)
+            assert (s is None) == (ref is None), (trial, presolve, info["status"])
+            assert presolve or info["presolve"] == "off"
+            if s is not None:
+                assert abs(info["correction"] - ref) <= 1e-7 * max(ref, 1.0), (trial, info["correction"], ref)
+                assert np.abs(s.ravel() - s0).sum() == pytest.approx(info["correction"], rel=1e-12)
         found[s is not None] += 1
-        if s is not None:
-            assert abs(info["correction"] - ref) <= 1e-7 * max(ref, 1.0), (trial, info["correction"], ref)
-            assert np.abs(s.ravel() - s0).sum() == pytest.approx(info["correction"], rel=1e-12)
     assert found[True] >= 20 and found[False] >= 5
+
+
+def test_thin_cone_projection_needs_no_presolve():
+    """One projection LP of the random walk of Figure 5 on a thin-cone slice (mu = 0.0027,
+    built at that mu: the default run's build member 1000, the walk's second LP; the
+    arrays ``solve_lp`` received), stored in tests/data.  With HiGHS's presolve the interior
+    point stops without progress and the dual simplex from scratch stops at the iteration
+    cap, so the round gets no vertex; without presolve the LP ends optimal at a point that
+    meets its rows and bounds to the feasibility tolerance (measured: 5e-10).  This is why
+    the walk's solver has ``finish_presolve: false`` (docs/governing.md)."""
+    d = np.load(Path(__file__).parent / "data" / "fig5_thin_cone_lp.npz")
+    M = sp.csc_matrix((d["data"], d["indices"], d["indptr"]), shape=tuple(d["shape"]))
+    args = (M, d["row_lo"], d["row_hi"], d["col_lo"], d["col_hi"], d["cost"])
+    x, info = finish_lp.solve_lp(*args)
+    assert x is None and info["status"] == "Iteration limit reached" and info["iterations"] == finish_lp.SIMPLEX_LIMIT
+    x, info = finish_lp.solve_lp(*args, presolve=False)
+    assert info["status"] == "Optimal" and info["presolve"] == "off", info
+    r = M @ x
+    viol = max((d["row_lo"] - r).max(), (r - d["row_hi"]).max(), (d["col_lo"] - x).max(), (x - d["col_hi"]).max())
+    assert viol <= finish_lp.FEASIBILITY
+
+
+def test_finish_presolve_must_be_a_bool():
+    with pytest.raises(ncd.InputError, match="finish_presolve"):
+        ncd.SolverSettings(finish_presolve="off")
+    assert ncd.SolverSettings().finish_presolve is True

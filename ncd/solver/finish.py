@@ -138,7 +138,7 @@ def project_statuses(W, q, mu, s0, status):
     return (P @ (x0 + min_norm_solve(K, r))).reshape(-1, 2)
 
 
-def polish(make_lp, W, q, mu, rho, scale, s0, status0, tol, more_sweeps, max_sweeps, sweeps0):
+def polish(make_lp, W, q, mu, rho, scale, s0, status0, tol, more_sweeps, max_sweeps, sweeps0, presolve=True):
     """Finishing stage (module docstring) from the NLGS iterate ``s0`` (``status0``, after
     ``sweeps0`` sweeps); ``more_sweeps(k) -> (s, status)`` runs NLGS on.  ``make_lp()``
     builds the :class:`StatusLP`, at the first projection only: most runs of an ensemble
@@ -146,7 +146,8 @@ def polish(make_lp, W, q, mu, rho, scale, s0, status0, tol, more_sweeps, max_swe
     are retried after chunks growing 4x, :data:`MAX_ATTEMPTS` times at most.  Returns ``(s,
     status, residual, lp_solves, ok, extra_sweeps, correction)``, the best iterate when the
     budget runs out; ``correction`` is ``|s - s_k|_1 / |s_k|_1`` of the accepted projection
-    (0 when NLGS got there)."""
+    (0 when NLGS got there).  ``presolve``: HiGHS's presolve on the projections
+    (:func:`ncd.solver.finish_lp.project`)."""
     def residual(s):
         return relative_residual(s, (W @ s.ravel() + q).reshape(-1, 2), mu, rho, scale)
 
@@ -170,9 +171,9 @@ def polish(make_lp, W, q, mu, rho, scale, s0, status0, tol, more_sweeps, max_swe
             attempts += 1
             solves += 1
             lp = make_lp() if lp is None else lp
-            cand, _, info = project(lp, s, status)
+            cand, _, info = project(lp, s, status, presolve=presolve)
             if cand is None and res <= REST_GATE:   # no solution with the iterate's statuses: the nearest at rest
-                cand, _, info = project(lp, s, rest_status(lp))
+                cand, _, info = project(lp, s, rest_status(lp), presolve=presolve)
                 LOG.debug("rest polyhedron: %s", info["status"])
             r = np.inf if cand is None else residual(cand)
             LOG.debug("sweeps %d residual %.2e: LP (%s, %d iterations) -> %.2e",
@@ -251,7 +252,7 @@ def polish_local(Wc, q, mu, Wd, data, order, result, settings):
         return StatusLP.local(Wc, q, mu, max(float(np.abs(s0).max(initial=0.0)), scale / np.sqrt(n)),
                               max(float(np.abs(q).max()), 1e-300))
     out = polish(make_lp, Wc, q, mu, 1.0 / Wd[:, 0, 0], scale, s0, status.copy(), settings.finish_tol, more,
-                 settings.max_sweeps, result.sweeps)
+                 settings.max_sweeps, result.sweeps, settings.finish_presolve)
     flat[:] = out[0].ravel()
     return _finished(result, *out)
 
@@ -280,7 +281,7 @@ def polish_discs(scene, contacts, vel, spin, bias, q_free, Wb, flat, order, resu
                               max(float(np.abs(s_start).max(initial=0.0)), scale / np.sqrt(n)),
                               max(float(np.abs(q_free).max()), 1e-300))
     out = polish(make_lp, W, q_free.ravel(), contacts.mu, 1.0 / Wb[:, 0, 0], scale, s_start, status.copy(),
-                 settings.finish_tol, more, settings.max_sweeps, result.sweeps)
+                 settings.finish_tol, more, settings.max_sweeps, result.sweeps, settings.finish_presolve)
     s = out[0]
     if not np.array_equal(s, imp.reshape(n, 2)):       # a projection: u_f = u_free + M^{-1} H s
         body[:nm, :3] = (free + minv * (H @ s.ravel())).reshape(nm, 3)

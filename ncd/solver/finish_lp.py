@@ -28,10 +28,11 @@ from ncd.solver.cone import cone_columns
 from ncd.solver.single_contact import NO_CONTACT, SLIDE_BACKWARD, SLIDE_FORWARD, STICK
 
 FEASIBILITY = 1e-9       # HiGHS primal feasibility tolerance, of the scaled rows
-# Crossover iterations at most: when the polyhedron of the NLGS statuses is empty the
-# interior-point stage does not say so and an uncapped crossover can run on without an
-# answer, while the projections that succeed need few.  A count, not a time limit: the
-# outcome does not depend on the machine's load.
+# Simplex iterations at most: when the polyhedron of the NLGS statuses is empty the
+# interior-point stage does not always say so, and where it stops without progress HiGHS
+# runs its dual simplex from scratch, which can go on without an answer, while the
+# projections that succeed need few.  A count, not a time limit: the outcome does not
+# depend on the machine's load.
 SIMPLEX_LIMIT = 2000
 OPTIONS = {"threads": 1, "solver": "ipm", "run_crossover": "on", "primal_feasibility_tolerance": FEASIBILITY,
            "dual_feasibility_tolerance": 1e-9, "simplex_iteration_limit": SIMPLEX_LIMIT}
@@ -62,7 +63,7 @@ class StatusLP:
         return cls(W, q, sp.csr_matrix((0, W.shape[1])), np.zeros(0), np.zeros(0), mu, S, V)
 
 
-def project(lp, s0, status, elastic=0.0):
+def project(lp, s0, status, elastic=0.0, presolve=True):
     """Point of the polyhedron of ``status`` nearest to ``s0`` (n, 2) in the L1 norm.
 
     Returns ``(s, y, info)``; ``s`` is None when the polyhedron is empty (or HiGHS
@@ -70,7 +71,9 @@ def project(lp, s0, status, elastic=0.0):
     iterations, ``correction`` = ``sum |s - s0|``.  With ``elastic > 0`` the velocity
     conditions of the statuses may be violated at that cost per unit of ``V`` (an exact
     penalty: always feasible); ``info["slack"]`` (n,) is each contact's violation / ``V``
-    (all 0: the point is the projection), which tells the statuses to change."""
+    (all 0: the point is the projection), which tells the statuses to change.
+    ``presolve=False``: HiGHS solves the LP as built, without its presolve
+    (:attr:`ncd.solver.settings.SolverSettings.finish_presolve`)."""
     n, ny = lp.n, lp.ny
     st = np.where(status > SLIDE_BACKWARD, STICK, status)
     closed = st != NO_CONTACT
@@ -119,7 +122,7 @@ def project(lp, s0, status, elastic=0.0):
         col_lo = np.concatenate([col_lo, np.zeros(2 * k)])
         col_hi = np.concatenate([col_hi, np.full(2 * k, INF)])
         cost = np.concatenate([cost, np.full(2 * k, float(elastic))])
-    x, info = _solve(M, row_lo, row_hi, col_lo, col_hi, cost)
+    x, info = solve_lp(M, row_lo, row_hi, col_lo, col_hi, cost, presolve)
     if x is None:
         return None, None, info
     s = (T @ x[ny:ny + m]).reshape(n, 2) * lp.S
@@ -130,11 +133,21 @@ def project(lp, s0, status, elastic=0.0):
     return s, x[:ny] * lp.y_scale, info
 
 
-def _solve(M, row_lo, row_hi, col_lo, col_hi, cost):
+def solve_lp(M, row_lo, row_hi, col_lo, col_hi, cost, presolve=True):
+    """``min cost . x`` subject to ``row_lo <= M x <= row_hi``, ``col_lo <= x <= col_hi`` (``M``
+    CSC) by HiGHS with :data:`OPTIONS`: ``(x, info)``, ``x`` None unless optimal.
+
+    ``presolve=False`` turns HiGHS's presolve off.  On the walk's projections of Figure 5's
+    thin-cone slices, the presolved LP stalled the interior point ("no progress", no
+    crossover); HiGHS then ran its dual simplex from scratch, with the pivots and vertex of
+    a plain dual simplex, and most of those runs stopped at :data:`SIMPLEX_LIMIT`.  The LP
+    as built let the interior point converge and the crossover reach a vertex."""
     h = highspy.Highs()
     h.silent()
     for k, v in OPTIONS.items():
         h.setOptionValue(k, v)
+    if not presolve:
+        h.setOptionValue("presolve", "off")
     lp = highspy.HighsLp()
     lp.num_col_, lp.num_row_ = M.shape[1], M.shape[0]
     lp.col_cost_, lp.col_lower_, lp.col_upper_ = cost, col_lo, col_hi
@@ -145,7 +158,13 @@ def _solve(M, row_lo, row_hi, col_lo, col_hi, cost):
     h.run()
     ms = h.getModelStatus()
     info = {"status": h.modelStatusToString(ms), "rows": M.shape[0], "cols": M.shape[1],
-            "iterations": int(h.getInfo().simplex_iteration_count)}
+            "iterations": int(h.getInfo().simplex_iteration_count), "presolve": _option(h, "presolve")}
     if ms != highspy.HighsModelStatus.kOptimal:
         return None, info
     return np.array(h.getSolution().col_value), info
+
+
+def _option(h, name):
+    """An option's value as HiGHS holds it (``highspy`` returns ``(status, value)`` or the value)."""
+    v = h.getOptionValue(name)
+    return v[1] if isinstance(v, tuple) else v

@@ -26,6 +26,9 @@ class SolverSettings:
 
     ``finish``: "none" or "active_set" (:mod:`ncd.solver.finish`: the iterate projected on
     the solutions with the contact statuses NLGS has settled, to ``finish_tol``).
+    ``finish_presolve``: HiGHS's presolve before the finishing stage's LPs (``False``: off;
+    on thin-cone slices of Figure 5 its reduced LP stalls the interior point, and the dual
+    simplex that follows from scratch stops at the iteration cap: docs/solvers.md).
     ``observable_tol``: largest relative change of an observed quantity over the last
     residual checks for a converged run (:mod:`ncd.solver.convergence`).
     ``keep_best``: at ``max_sweeps`` return the iterate of smallest residual seen
@@ -42,6 +45,7 @@ class SolverSettings:
     check_every: int = 1          # sweeps between residual evaluations
     finish: str = "none"          # "none" or "active_set"
     finish_tol: float = 1e-10
+    finish_presolve: bool = True
     observable_tol: float = 1e-6
     keep_best: bool = True
     accel: str = "none"           # "none" or "anderson"
@@ -94,7 +98,7 @@ def check_solver_settings(settings: SolverSettings, name: str = "settings") -> S
         raise InputError(f"{name}.finish = {settings.finish!r} must be one of {FINISHES}")
     for field in ("finish_tol", "observable_tol"):
         object.__setattr__(settings, field, real(f"{name}.{field}", getattr(settings, field), 0.0, lo_open=True))
-    for field in ("keep_best", "local_exact"):
+    for field in ("keep_best", "local_exact", "finish_presolve"):
         if not isinstance(getattr(settings, field), (bool, np.bool_)):
             raise InputError(f"{name}.{field} = {getattr(settings, field)!r} must be True or False")
     if not isinstance(settings.accel, str) or settings.accel not in ACCELS:
