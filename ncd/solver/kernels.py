@@ -2,8 +2,9 @@
 form and in local form.
 
 A sweep reviews the contacts in ``review_order`` and solves each exactly with the
-others frozen (:func:`ncd.solver.single_contact.solve_single_contact`), propagating at
-once (Moreau 2005, section 2). In disc form the body velocities are updated
+others frozen (:func:`ncd.solver.single_contact.solve_single_contact`; in disc form its
+diagonal-block case :func:`~ncd.solver.single_contact.solve_disc_contact`, the same bit for
+bit), propagating at once (Moreau 2005, section 2). In disc form the body velocities are updated
 incrementally, ``u += M^-1 H_alpha (s_new - s_old)`` (packed arrays of
 :mod:`ncd.solver.pack`), so a sweep costs O(contacts); in local form ``U = W s + q``
 with ``W`` in CSR. The residual is the natural map, ``rho_alpha = 1 / W_alpha,nn``,
@@ -16,7 +17,7 @@ import numpy as np
 
 from ncd.core.jit import njit
 from ncd.solver.pack import C_BN, C_BT, C_MU, C_WNN, C_WTT, N_COEF, add_impulse, relative_velocity
-from ncd.solver.single_contact import natural_map_sq, solve_single_contact
+from ncd.solver.single_contact import natural_map_sq, solve_disc_contact, solve_single_contact
 
 
 # The drivers below are written once per form on purpose: passing the sweep and
@@ -67,7 +68,7 @@ def sweep_discs(data, order, status):
         st = imp[2 * c + 1]
         qn = un - wnn * sn + coef[j + C_BN]
         qt = ut - wtt * st + coef[j + C_BT]
-        rn, rt, st_ = solve_single_contact(wnn, 0.0, 0.0, wtt, qn, qt, coef[j + C_MU])
+        rn, rt, st_ = solve_disc_contact(wnn, wtt, qn, qt, coef[j + C_MU])
         status[c] = st_
         dn = rn - sn
         dt = rt - st

@@ -75,6 +75,32 @@ def solve_single_contact(wnn, wnt, wtn, wtt, qn, qt, mu):
 
 
 @njit(cache=True, error_model="numpy")
+def solve_disc_contact(wnn, wtt, qn, qt, mu):
+    """:func:`solve_single_contact` for a disc contact's diagonal block (``W_nt = W_tn = 0``),
+    with the same result bit for bit on finite input: the products of the zero entries
+    only add signed zeros to non-zero terms (``q_n < 0`` here, ``W_nn, W_tt > 0``), which
+    leaves every sum and every comparison unchanged; dropping them spares the sweep's
+    hot loop their multiplications."""
+    if qn >= 0.0:
+        return 0.0, 0.0, NO_CONTACT
+    det = wnn * wtt
+    rn = (-wtt * qn) / det
+    rt = -(wnn * qt) / det
+    if rn >= 0.0 and abs(rt) <= mu * rn:
+        return rn, rt, STICK
+    if wnn > 0.0:
+        sn = -qn / wnn
+        st = -mu * sn
+        if wtt * st + qt >= 0.0:
+            return sn, st, SLIDE_FORWARD
+        st = mu * sn
+        if wtt * st + qt <= 0.0:
+            return sn, st, SLIDE_BACKWARD
+    pn, pt = project_cone(rn, rt, mu)
+    return pn, pt, FALLBACK
+
+
+@njit(cache=True, error_model="numpy")
 def natural_map_sq(rn, rt, un, ut, mu, rho):
     """Squared norm of the natural map ``r - proj_K(r - rho U~)`` for one contact."""
     zn = rn - rho * (un + mu * abs(ut))

@@ -1,7 +1,8 @@
 /* The NLGS sweep of ncd (ncd/solver/kernels.py: sweep_discs;
- * ncd/solver/single_contact.py: solve_single_contact) in
- * plain C, on the same packed arrays, as the hardware reference of
- * ncd/studies/bench/solver.py (nlgs_sweep_cost).  Input: a raw file written by ncd.studies.bench.solver
+ * ncd/solver/single_contact.py: solve_single_contact, the general formulas, which the
+ * sweep's solve_disc_contact must match bit for bit) in plain C, on the same packed
+ * arrays, as the hardware reference of ncd/studies/bench/solver.py (nlgs_sweep_cost).
+ * Input: a raw file written by ncd.studies.bench.solver
  *   int64 n, n_body, sweeps; int64 order[n]; int32 pair[n][2];
  *   double coef[n][13]; double body[n_body][4]; double imp[n][2]
  * The Delassus blocks of disc contacts are diagonal (W_nt = W_tn = 0).
