@@ -42,8 +42,9 @@ def test_an_edit_of_a_callee_module_reaches_the_cached_kernels(tmp_path):
     # of kernels.py must see it (here: every normal impulse doubled)
     solver = tmp_path / "ncd" / "solver" / "single_contact.py"
     text = solver.read_text()
-    assert text.count("return rn, rt, STICK") == 1
-    solver.write_text(text.replace("return rn, rt, STICK", "return 2.0 * rn, rt, STICK"))
+    stick = "return rn, rt, STICK\n    # slide forward"      # solve_single_contact's (solve_local's) case
+    assert text.count(stick) == 1
+    solver.write_text(text.replace(stick, "return 2.0 * rn, rt, STICK\n    # slide forward"))
     second_dir, second = probe(tmp_path)
     assert second_dir != first_dir
     assert eval(second)[0] == 2.0 * eval(first)[0] != 0.0
