@@ -20,7 +20,7 @@ with each other.  Trade-offs: docs/solvers.md.
 import numpy as np
 
 from ncd.core.jit import njit
-from ncd.solver.kernels import check_now, done, relative, remember_best, residual_discs, sweep_discs
+from ncd.solver.kernels import check_now, done, reads_change, relative, remember_best, residual_discs, sweep_discs
 from ncd.solver.pack import C_MU, N_COEF, apply_all
 from ncd.solver.single_contact import project_cone
 
@@ -193,8 +193,10 @@ def _iterate_anderson(data, order, status, scale, tol, max_sweeps, criterion, ch
     res = np.inf
     for k in range(1, max_sweeps + 1):
         x[:] = imp
-        dsum, ssum = sweep_discs(data, order, status)
-        change = relative(dsum, ssum)
+        measure = reads_change(k, max_sweeps, criterion, check_every)
+        dsum, ssum = sweep_discs(data, order, status, measure)
+        if measure:
+            change = relative(dsum, ssum)
         if check_now(k, change, tol, max_sweeps, criterion, check_every):
             rsq, ssq = residual_discs(data)
             res = np.sqrt(rsq) / max(scale, np.sqrt(ssq), 1e-300)

@@ -26,8 +26,21 @@ from ncd.solver.single_contact import natural_map_sq, solve_disc_contact, solve_
 # recompile the driver, add an entry to the cache index, and eventually fail to
 # pickle the index ("underlying object has vanished").
 @njit(cache=True, inline="always")
+def scheduled_check(k, max_sweeps, check_every):
+    """Sweep ``k`` is one of the scheduled residual checks (every ``check_every``-th, and the last)."""
+    return k % check_every == 0 or k == max_sweeps
+
+
+@njit(cache=True, inline="always")
 def check_now(k, change, tol, max_sweeps, criterion, check_every):
-    return k % check_every == 0 or k == max_sweeps or (criterion == 1 and change <= tol)
+    return scheduled_check(k, max_sweeps, check_every) or (criterion == 1 and change <= tol)
+
+
+@njit(cache=True, inline="always")
+def reads_change(k, max_sweeps, criterion, check_every):
+    """Whether a driver reads sweep ``k``'s change: at the scheduled checks, and at every
+    sweep under the change criterion (:func:`sweep_discs`' ``measure``)."""
+    return criterion == 1 or scheduled_check(k, max_sweeps, check_every)
 
 
 @njit(cache=True, inline="always")
@@ -107,8 +120,7 @@ def iterate_discs(data, order, status, scale, tol, max_sweeps, criterion, check_
     change = np.inf
     res = np.inf
     for k in range(1, max_sweeps + 1):
-        # the change is read at the checks only (and at every sweep under the change criterion)
-        measure = criterion == 1 or k % check_every == 0 or k == max_sweeps
+        measure = reads_change(k, max_sweeps, criterion, check_every)
         dsum, ssum = sweep_discs(data, order, status, measure)
         if measure:
             change = relative(dsum, ssum)
