@@ -28,6 +28,24 @@ class PolytopeError(RuntimeError):
     """``A ∩ C`` is empty, or unbounded where a bounded set is needed, or an LP failed."""
 
 
+@njit(cache=True, error_model="numpy")
+def chord(slack, g):
+    """``(lo, hi)``: the step lengths ``t`` along a direction of row slopes ``g`` that keep
+    ``slack - t g >= 0``.  Branch-free: every quotient is computed and a row that does not
+    bound a side gives that side's infinity, which ``min``/``max`` leave as they were, so
+    the bounds are those of the branchy loop bit for bit (the same quotients, met in the same
+    order), without its mispredicted branch per row (rows of either sign alternate at
+    random); a zero slope's quotient is never selected (numpy error model: no raise)."""
+    lo = -np.inf
+    hi = np.inf
+    for i in range(slack.shape[0]):
+        gi = g[i]
+        q = slack[i] / gi
+        hi = min(hi, q if gi > 0.0 else np.inf)
+        lo = max(lo, q if gi < 0.0 else -np.inf)
+    return lo, hi
+
+
 @njit(cache=True)
 def _hit_and_run(G, slack, y, L, thin, normals, uniforms):
     """Hit-and-run steps in ``{y : G y <= b}``, ``slack = b - G y`` kept up to date (both
@@ -40,13 +58,7 @@ def _hit_and_run(G, slack, y, L, thin, normals, uniforms):
     for s in range(steps):
         dirn = L @ normals[s]
         gd = G @ dirn
-        lo = -np.inf
-        hi = np.inf
-        for i in range(m):
-            if gd[i] > 0.0:
-                hi = min(hi, slack[i] / gd[i])
-            elif gd[i] < 0.0:
-                lo = max(lo, slack[i] / gd[i])
+        lo, hi = chord(slack, gd)
         lam = lo + (hi - lo) * uniforms[s]
         y += lam * dirn
         for i in range(m):
@@ -73,14 +85,7 @@ def _coordinate_hit_and_run(GLt, slack, z, thin, coords, uniforms):
     k = 0
     for s in range(steps):
         j = coords[s]
-        lo = -np.inf
-        hi = np.inf
-        for i in range(m):
-            g = GLt[j, i]
-            if g > 0.0:
-                hi = min(hi, slack[i] / g)
-            elif g < 0.0:
-                lo = max(lo, slack[i] / g)
+        lo, hi = chord(slack, GLt[j])
         lam = lo + (hi - lo) * uniforms[s]
         z[j] += lam
         for i in range(m):
