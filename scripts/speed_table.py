@@ -5,11 +5,14 @@
 
 RESULTS_DIR is the directory holding ``bench/`` after ``snakemake -j2 bench`` (``results``).
 docs/speed.tsv keeps the numbers of the last regeneration, so that the README's table can be
-checked against its source without the run (tests/test_readme.py)."""
+checked against its source without the run (tests/test_readme.py).  The rows of a bench file
+absent from RESULTS_DIR are kept from docs/speed.tsv (speed_table.merge_rows): a run of the
+default target and ``bench_dag`` alone updates the default run's rows."""
 import sys
 from pathlib import Path
 
 from ncd.studies.bench.speed_table import (
+    merge_rows,
     read_speed_csv,
     replace_speed_block,
     speed_block,
@@ -31,7 +34,7 @@ def main(argv):
     if len(argv) != 1 or not (Path(argv[0]) / "bench").is_dir():
         print(__doc__)
         return 2
-    rows = speed_rows(argv[0])
+    rows = merge_rows(speed_rows(argv[0]), read_speed_csv(SOURCE), argv[0])
     write_speed_csv(rows, SOURCE)
     README.write_text(replace_speed_block(README.read_text(), speed_markdown(rows)))
     print(f"{len(rows)} rows from {argv[0]}/bench -> {SOURCE.relative_to(ROOT)}, README.md")

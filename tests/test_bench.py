@@ -352,3 +352,20 @@ def test_bench_sampler_kinds_agree_on_the_same_slices(results):
     eta = s.eta_uniform.values[both]
     assert (np.abs(eta[:, 1] / eta[:, 0] - 1) <= MIXED_GAP).all(), eta
     np.testing.assert_array_equal(s.dimension.values, p.dim_AC_rank.values[s.analysis.values])
+
+
+def test_speed_table_keeps_the_rows_of_absent_bench_files(tmp_path):
+    """A run with dag.nc only updates the default run's rows and keeps core.nc's from the
+    committed table, in table order; a row from a file no bench rule writes is refused."""
+    d = tmp_path / "bench"
+    d.mkdir()
+    xr.Dataset(attrs={"cpu_s": 3810.2, "critical_path_s": 363.4, "ideal_s": 1905.1, "cores": 2}).to_netcdf(d / "dag.nc")
+    old = [{"quantity": "default run: core time of all jobs (wall x threads)", "value": "1327", "unit": "s",
+            "source": "results/bench/dag.nc"},
+           {"quantity": "NLGS contact update, N = 10044: numba / C", "value": "18 / 15.6", "unit": "ns",
+            "source": "results/bench/core.nc"}]
+    rows = speed_table.merge_rows(speed_table.speed_rows(tmp_path), old, tmp_path)
+    assert [r["value"] for r in rows] == ["3810", "363", "1905", "18 / 15.6"]
+    assert speed_table.merge_rows([], old, tmp_path / "nothing") == old
+    with pytest.raises(ValueError, match="other.nc"):
+        speed_table.merge_rows([], old + [{**old[1], "source": "results/bench/other.nc"}], tmp_path)

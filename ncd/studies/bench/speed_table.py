@@ -68,6 +68,25 @@ def speed_rows(results):
     return rows
 
 
+SOURCES = ("dag.nc", "core.nc", "tolerance_problems.nc", "exact_sets.nc", "peer.nc")   # in table order
+
+
+def merge_rows(new, previous, results):
+    """The table after a run that produced only some of the bench files: ``new``
+    (:func:`speed_rows` of ``results``) for every file present there, ``previous`` (the
+    committed table) for the others, in :data:`SOURCES` order.  A row is kept only
+    while its own file is absent: one run's numbers never mix with another's within a
+    file's rows, and each row names the file it comes from."""
+    present = {f for f in SOURCES if (Path(results) / "bench" / f).exists()}
+
+    def name(r):
+        return r["source"].rsplit("/", 1)[-1]
+    unknown = sorted({name(r) for r in previous} - set(SOURCES))
+    if unknown:
+        raise ValueError(f"previous speed table: rows from {unknown}, not among the bench files {SOURCES}")
+    return [r for f in SOURCES for r in (new if f in present else previous) if name(r) == f]
+
+
 def write_speed_csv(rows, path):
     """The rows of :func:`speed_rows` as a tab-separated file (the table's committed source)."""
     lines = ["\t".join(SPEED_COLUMNS)] + ["\t".join(r[c] for c in SPEED_COLUMNS) for r in rows]
