@@ -369,3 +369,5 @@ def test_speed_table_keeps_the_rows_of_absent_bench_files(tmp_path):
     assert speed_table.merge_rows([], old, tmp_path / "nothing") == old
     with pytest.raises(ValueError, match="other.nc"):
         speed_table.merge_rows([], old + [{**old[1], "source": "results/bench/other.nc"}], tmp_path)
+    with pytest.raises(ValueError, match="new speed rows from .'other.nc'"):
+        speed_table.merge_rows([{**old[1], "source": "results/bench/other.nc"}], old, tmp_path)

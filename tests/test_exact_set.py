@@ -156,11 +156,11 @@ def test_clp_model_refuses_arrays_of_the_wrong_length_before_clp_reads_them():
 
 
 def test_chord_bounds_bit_for_bit_as_the_branchy_loop():
-    """The hit-and-run chord (``ncd.exact.polytope.chord``, branch-free) against the loop
+    """The hit-and-run chord (``ncd.exact.polytope._chord``, branch-free) against the loop
     that divides only where a row bounds a side: the same bounds bit for bit, with zero
     slopes, zero slacks and rows of both signs; a direction that no row bounds gives
     infinite bounds on both sides."""
-    from ncd.exact.polytope import chord
+    from ncd.exact.polytope import _chord as chord
 
     def branchy(slack, g):
         lo, hi = -np.inf, np.inf

@@ -29,7 +29,7 @@ class PolytopeError(RuntimeError):
 
 
 @njit(cache=True, error_model="numpy")
-def chord(slack, g):
+def _chord(slack, g):
     """``(lo, hi)``: the step lengths ``t`` along a direction of row slopes ``g`` that keep
     ``slack - t g >= 0``.  Branch-free: every quotient is computed and a row that does not
     bound a side gives that side's infinity, which ``min``/``max`` leave as they were, so
@@ -58,7 +58,7 @@ def _hit_and_run(G, slack, y, L, thin, normals, uniforms):
     for s in range(steps):
         dirn = L @ normals[s]
         gd = G @ dirn
-        lo, hi = chord(slack, gd)
+        lo, hi = _chord(slack, gd)
         lam = lo + (hi - lo) * uniforms[s]
         y += lam * dirn
         for i in range(m):
@@ -85,7 +85,7 @@ def _coordinate_hit_and_run(GLt, slack, z, thin, coords, uniforms):
     k = 0
     for s in range(steps):
         j = coords[s]
-        lo, hi = chord(slack, GLt[j])
+        lo, hi = _chord(slack, GLt[j])
         lam = lo + (hi - lo) * uniforms[s]
         z[j] += lam
         for i in range(m):

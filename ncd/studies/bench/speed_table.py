@@ -81,9 +81,10 @@ def merge_rows(new, previous, results):
 
     def name(r):
         return r["source"].rsplit("/", 1)[-1]
-    unknown = sorted({name(r) for r in previous} - set(SOURCES))
-    if unknown:
-        raise ValueError(f"previous speed table: rows from {unknown}, not among the bench files {SOURCES}")
+    for label, rows in (("new", new), ("previous", previous)):    # a file missing from SOURCES would drop its rows
+        unknown = sorted({name(r) for r in rows} - set(SOURCES))
+        if unknown:
+            raise ValueError(f"{label} speed rows from {unknown}, not among the bench files {SOURCES}")
     return [r for f in SOURCES for r in (new if f in present else previous) if name(r) == f]
 
 
