@@ -404,3 +404,85 @@ def test_finish_presolve_must_be_a_bool():
     with pytest.raises(ncd.InputError, match="finish_presolve"):
         ncd.SolverSettings(finish_presolve="off")
     assert ncd.SolverSettings().finish_presolve is True
+
+
+def _single_disc_lp():
+    scene = make_scene([[0.0, 0.01]], 0.01, 1.0, walls=[((0.0, 0.0), (0.0, 1.0))], mu=0.5)
+    problem = _rest_problem(scene)
+    W, Hm, minv = finish.global_delassus(scene, problem.contacts)
+    free = np.column_stack([problem.free_vel[:1], problem.free_spin[:1]]).ravel()
+    lp = finish_lp.StatusLP.discs(Hm, minv, free, problem.bias, problem.contacts.mu, scene.radius[:1], 1e-3, 1e-2)
+    return lp, scene.mass[0] * 9.81 * H
+
+
+def test_a_projection_is_skipped_only_where_it_must_be_a_jump(monkeypatch):
+    """The L1 distance to a set is 1-Lipschitz: from an iterate whose projection moved it by
+    ``d``, one ``e`` away is at least ``d - e`` from the set.  On the single disc, whose
+    sticking polyhedron is the point ``(m g h, 0)``, a projection is skipped where that bound
+    exceeds the jump threshold (and the LP confirms a jump there), and solved where it does
+    not, both where the LP then finds a jump and where it finds none."""
+    lp, mgh = _single_disc_lp()
+    stick = np.array([STICK], np.int8)
+    calls = []
+    monkeypatch.setattr(finish, "project", lambda *a, **k: calls.append(1) or finish_lp.project(*a, **k))
+
+    def distance(s):
+        return finish_lp.project(lp, s, stick)[2]["correction"]
+
+    seen = {}
+    far = np.array([[0.5 * mgh, 0.1 * mgh]])                  # 0.6 m g h away: a jump
+    cand, info = finish.project_unless_jump(lp, far, stick, True, seen)
+    assert cand is not None and len(calls) == 1
+    near_far = far + [[0.01 * mgh, 0.0]]                       # bound 0.59 m g h > 0.05 |s|: skipped
+    cand, info = finish.project_unless_jump(lp, near_far, stick, True, seen)
+    assert cand is None and info["status"].startswith("skipped") and len(calls) == 1
+    assert distance(near_far) > finish.MAX_CORRECTION * np.abs(near_far).sum()
+    close = np.array([[0.99 * mgh, 0.0]])                     # bound negative: solved, not a jump
+    cand, info = finish.project_unless_jump(lp, close, stick, True, seen)
+    assert cand is not None and len(calls) == 2
+    assert info["correction"] <= finish.MAX_CORRECTION * np.abs(close).sum()
+    # a jump the bound cannot see: from the close iterate's record, a far one is solved
+    cand, info = finish.project_unless_jump(lp, far, stick, True, seen)
+    assert cand is not None and len(calls) == 3
+
+
+def test_skipping_jumps_leaves_the_finishing_stage_as_it_was(lp_now, monkeypatch):
+    """An iterate that stalls on its statuses (one contact sliding) far from their
+    polyhedron, here the point ``P``, while the states at rest are the point ``Q`` nearby:
+    every projection on its statuses is a jump, and since the polyhedron is not empty the
+    stage never tries the rest polyhedron.  It projects after each chunk, as many as
+    ``MAX_ATTEMPTS``; skipping those the distance bound rules out must leave its result
+    unchanged bit for bit and call the LP on a subsequence of the same polyhedra: here one
+    LP instead of three, and never the rest polyhedron (a skipped projection is a rejected
+    candidate, not an empty polyhedron)."""
+    P, Q = np.array([[3.0, -1.5]]), np.array([[1.0, 0.01]])
+    slide = np.array([SLIDE_FORWARD], np.int8)
+
+    class Steps:                                   # rest_status reads b: a closed contact
+        b = np.array([-1.0, 0.0])
+
+    def project(lp, s0, status, presolve=True):
+        point = P if np.array_equal(status, slide) else Q
+        calls.append(int(status[0]))
+        return point.copy(), None, {"status": "Optimal", "iterations": 0,
+                                    "correction": float(np.abs(point - s0).sum())}
+    monkeypatch.setattr(finish, "project", project)
+    W, mu = sp.identity(2, format="csr"), np.array([0.5])
+    s0 = np.array([[1.0, -0.5]])                    # on the sliding edge, U = (1e-9, 0): residual ~ 1e-9
+    q = -s0.ravel() + [1e-9, 0.0]
+    runs = []
+    for margin in (np.inf, finish.JUMP_MARGIN):               # inf: nothing skipped
+        monkeypatch.setattr(finish, "JUMP_MARGIN", margin)
+        calls = []
+        s = s0.copy()
+
+        def creep(k, s=s):
+            s += [[1e-12, 0.0]]
+            return s.copy(), slide.copy()
+        out = finish.polish(Steps, W, q, mu, np.array([1.0]), 1.0, s0.copy(), slide.copy(), 1e-300, creep, 400, 100)
+        runs.append((out, calls))
+    (a, calls_all), (b, calls_skip) = runs
+    assert 1e-300 < a[2] <= finish.REST_GATE and a[3] == b[3] == finish.MAX_ATTEMPTS
+    assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1]) and a[2] == b[2]
+    assert a[4] is b[4] is False and a[5] == b[5]
+    assert calls_all == [SLIDE_FORWARD] * finish.MAX_ATTEMPTS and calls_skip == [SLIDE_FORWARD]

@@ -29,6 +29,7 @@ LP_SWEEPS = 50000        # NLGS goes on while its rate predicts finish_tol withi
 MAX_ATTEMPTS = 3         # failed projections (an empty polyhedron is a long LP) before NLGS alone
 REST_GATE = 1e-5         # the rest polyhedron is tried from iterates this close only (far ones: long LPs, rejected)
 MAX_CORRECTION = 0.05    # a projection moving the impulses by more (relative L1) is a jump: rejected
+JUMP_MARGIN = 1e-6       # relative L1: a projection skipped as a jump only when its bound clears MAX_CORRECTION by this
 LOG = logging.getLogger(__name__)
 REFINE = 30              # iterated-Tikhonov refinements of one minimum-norm correction (census)
 
@@ -156,6 +157,7 @@ def polish(make_lp, W, q, mu, rho, scale, s0, status0, tol, more_sweeps, max_swe
     best = (res, s, status)
     solves, attempts, extra, chunk, rate = 0, 0, 0, max(FIRST_CHUNK, sweeps0 // 4, 1), None
     lp = None
+    seen = {}       # polyhedron (its statuses' bytes) -> (iterate, L1 distance) of its last projection
     while True:
         if res <= tol:
             return s, status, res, solves, True, extra, 0.0
@@ -171,9 +173,9 @@ def polish(make_lp, W, q, mu, rho, scale, s0, status0, tol, more_sweeps, max_swe
             attempts += 1
             solves += 1
             lp = make_lp() if lp is None else lp
-            cand, _, info = project(lp, s, status, presolve=presolve)
-            if cand is None and res <= REST_GATE:   # no solution with the iterate's statuses: the nearest at rest
-                cand, _, info = project(lp, s, rest_status(lp), presolve=presolve)
+            cand, info = project_unless_jump(lp, s, status, presolve, seen)
+            if cand is None and not info["jump"] and res <= REST_GATE:   # no solution with its statuses: the nearest at rest
+                cand, info = project_unless_jump(lp, s, rest_status(lp), presolve, seen)
                 LOG.debug("rest polyhedron: %s", info["status"])
             r = np.inf if cand is None else residual(cand)
             LOG.debug("sweeps %d residual %.2e: LP (%s, %d iterations) -> %.2e",
@@ -199,6 +201,30 @@ def polish(make_lp, W, q, mu, rho, scale, s0, status0, tol, more_sweeps, max_swe
         s, res = s_new, res_new
         if res < best[0]:
             best = (res, s, status)
+
+
+def project_unless_jump(lp, s, status, presolve, seen):
+    """:func:`ncd.solver.finish_lp.project` of ``s`` on the polyhedron of ``status``, skipped
+    when its answer can only be a jump: the L1 distance to a set is 1-Lipschitz in the L1
+    norm, so an iterate ``s`` at most ``|s - s'|_1`` nearer than an earlier iterate ``s'``
+    projected on the same polyhedron (``seen``) lies at least ``d(s') - |s - s'|_1`` from it.
+    Where that bound exceeds :data:`MAX_CORRECTION` (plus :data:`JUMP_MARGIN`, far above the
+    LP's tolerances), the projection would be rejected whatever vertex the LP returned, so
+    :func:`polish` goes on exactly as after it (a rejected candidate, so no rest polyhedron
+    after a skipped status projection): the same sweeps, projections and result.  Returns
+    ``(candidate or None, info)``, ``info["jump"]`` True where the projection was skipped."""
+    key = status.tobytes()
+    size = np.abs(s).sum()
+    if key in seen:
+        s_prev, d_prev = seen[key]
+        if d_prev - np.abs(s - s_prev).sum() > (MAX_CORRECTION + JUMP_MARGIN) * size:
+            return None, {"status": "skipped: a jump by the distance of an earlier iterate", "iterations": 0,
+                          "jump": True}
+    cand, _, info = project(lp, s, status, presolve=presolve)
+    info["jump"] = False
+    if cand is not None:
+        seen[key] = (s.copy(), info["correction"])
+    return cand, info
 
 
 def rest_status(lp):
