@@ -458,7 +458,7 @@ def test_skipping_jumps_leaves_the_finishing_stage_as_it_was(lp_now, monkeypatch
     P, Q = np.array([[3.0, -1.5]]), np.array([[1.0, 0.01]])
     slide = np.array([SLIDE_FORWARD], np.int8)
 
-    class Steps:                                   # rest_status reads b: a closed contact
+    class OneContactLP:                            # what rest_status reads of a StatusLP: b_n < 0, closed
         b = np.array([-1.0, 0.0])
 
     def project(lp, s0, status, presolve=True):
@@ -479,7 +479,7 @@ def test_skipping_jumps_leaves_the_finishing_stage_as_it_was(lp_now, monkeypatch
         def creep(k, s=s):
             s += [[1e-12, 0.0]]
             return s.copy(), slide.copy()
-        out = finish.polish(Steps, W, q, mu, np.array([1.0]), 1.0, s0.copy(), slide.copy(), 1e-300, creep, 400, 100)
+        out = finish.polish(OneContactLP, W, q, mu, np.array([1.0]), 1.0, s0.copy(), slide.copy(), 1e-300, creep, 400, 100)
         runs.append((out, calls))
     (a, calls_all), (b, calls_skip) = runs
     assert 1e-300 < a[2] <= finish.REST_GATE and a[3] == b[3] == finish.MAX_ATTEMPTS
